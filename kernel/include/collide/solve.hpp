@@ -1,0 +1,86 @@
+// collide/solve.hpp - resolving a batch of contacts.
+//
+// Every contact is resolved by the law of docs/collision-law.md. The result
+// does not depend on the path, the SIMD width or the thread count: all paths
+// run the same kernel body (kernel/src/contact_kernel.hpp) with the same IEEE
+// operations in the same order and no fused multiply-add, so they agree bit
+// for bit. Contacts that share a movable body are applied in input order
+// (see schedule.hpp).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+#include "collide/schedule.hpp"
+
+namespace collide {
+
+/// Which implementation of the kernel runs.
+enum class Path {
+  scalar,  ///< one contact at a time (lane width 1)
+  simd,    ///< SIMD lanes: 8 float / 4 double with AVX2, 4 / 2 with SSE2
+};
+
+/// The body model a kernel runs. Only the rigid model exists so far.
+enum class Model { rigid };
+
+const char* to_string(Path path);
+const char* to_string(Model model);
+
+struct SolverOptions {
+  Path path = Path::simd;
+  /// Worker threads; 0 means every hardware thread. Results do not depend on it.
+  int threads = 0;
+  /// Contacts per parallel task inside a batch (rounded up to the lane width).
+  /// Smaller batches than two blocks run on the calling thread.
+  std::size_t block = 4096;
+};
+
+/// What a solve did.
+struct SolveStats {
+  std::size_t contacts = 0;  ///< contacts resolved (including those with J = 0)
+  std::size_t batches = 0;   ///< batches run one after another
+  std::size_t lanes = 0;     ///< SIMD width used for this precision
+  int threads = 0;           ///< threads available to the solve
+  Model model = Model::rigid;
+  Path path = Path::simd;
+};
+
+/// Number of lanes of the SIMD path for T in this build.
+template <class T>
+std::size_t simd_width();
+
+/// A reusable solver. It owns the worker threads (a tbb::task_arena) and
+/// allocates nothing while solving, so one Solver can run every frame.
+class Solver {
+ public:
+  explicit Solver(const SolverOptions& options = {});
+  ~Solver();
+  Solver(const Solver&) = delete;
+  Solver& operator=(const Solver&) = delete;
+  Solver(Solver&&) noexcept;
+  Solver& operator=(Solver&&) noexcept;
+
+  [[nodiscard]] const SolverOptions& options() const;
+
+  /// Resolves every contact: updates v and w of movable bodies and writes J.
+  /// Preconditions (checked by validate(), asserted in debug builds): the
+  /// schedule was built for these contacts and bodies, impulses.count ==
+  /// contacts.count, indices in range, a != b, finite inputs.
+  template <class T>
+  SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-shot convenience: builds a schedule and a solver and solves.
+template <class T>
+SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                 const SolverOptions& options = {});
+
+}  // namespace collide
