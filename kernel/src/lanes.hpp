@@ -1,0 +1,149 @@
+// lanes.hpp - the private, width-generic lane type the kernels are written in.
+//
+// Design notes
+// ------------
+// The physics is written once (contact_kernel.hpp) over a lane type V that
+// holds W values of float or double. Two lane types exist:
+//   * ScalarLanes<T>: std::experimental::simd with the scalar ABI, W = 1;
+//   * SimdLanes<T>:   std::experimental::simd with the native ABI of the
+//     build (AVX2: 8 float / 4 double; SSE2: 4 / 2).
+// Both are the same class template, so one kernel body instantiates for both
+// with no second copy of the math. std::experimental::simd (GCC's libstdc++,
+// Parallelism TS 2) was chosen over hand-written intrinsics and over Eigen
+// fixed-size arrays because it is width-generic by construction, has masks and
+// `where`, costs no dependency, and produced the same inner loop as
+// intrinsics in our measurement (README, "Choosing the lane layer").
+//
+// AVX2 has gathers but no scatters, and on the AMD Zen cores we run on a
+// vgatherdps is no faster than scalar loads, so gather() is a generator
+// constructor (W scalar loads) and scatter() W scalar stores; the compiler
+// builds the vectors with inserts.
+//
+// Floating point: every operation here is an IEEE add, sub, mul, div, sqrt,
+// min or compare, each correctly rounded; with -ffp-contract=off nothing is
+// fused, so a lane computes bit for bit what the scalar path computes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <experimental/simd>
+
+namespace collide::detail {
+
+namespace stdx = std::experimental;
+
+template <class T>
+using ScalarLanes = stdx::simd<T, stdx::simd_abi::scalar>;
+template <class T>
+using SimdLanes = stdx::native_simd<T>;
+
+/// b where the mask is false, a where it is true.
+template <class V>
+inline V select(const typename V::mask_type& m, const V& a, const V& b) {
+  V r = b;
+  stdx::where(m, r) = a;
+  return r;
+}
+
+/// W consecutive values starting at p.
+template <class V>
+inline V load(const typename V::value_type* p) {
+  return V(p, stdx::element_aligned);
+}
+
+template <class V>
+inline void store(const V& v, typename V::value_type* p) {
+  v.copy_to(p, stdx::element_aligned);
+}
+
+/// base[idx[0]], ..., base[idx[W-1]].
+template <class V, class Index>
+inline V gather(const typename V::value_type* base, const Index* idx) {
+  return V([&](auto lane) { return base[idx[lane]]; });
+}
+
+/// base[idx[l]] = v[l] for every lane l whose `write` is true.
+template <class V, class Index>
+inline void scatter(const V& v, typename V::value_type* base, const Index* idx, const typename V::mask_type& write) {
+  for (std::size_t l = 0; l < V::size(); ++l) {
+    if (write[l]) base[idx[l]] = v[l];
+  }
+}
+
+/// A 3-vector of lanes.
+template <class V>
+struct Vec3 {
+  V x, y, z;
+};
+
+template <class V>
+inline Vec3<V> operator+(const Vec3<V>& a, const Vec3<V>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class V>
+inline Vec3<V> operator-(const Vec3<V>& a, const Vec3<V>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class V>
+inline Vec3<V> operator*(const Vec3<V>& a, const V& s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+/// Component-wise product (diagonal matrix times vector).
+template <class V>
+inline Vec3<V> hadamard(const Vec3<V>& a, const Vec3<V>& b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+template <class V>
+inline V dot(const Vec3<V>& a, const Vec3<V>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class V>
+inline Vec3<V> cross(const Vec3<V>& a, const Vec3<V>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+template <class V>
+inline Vec3<V> select(const typename V::mask_type& m, const Vec3<V>& a, const Vec3<V>& b) {
+  return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+}
+
+/// A rotation matrix of lanes, row-major: r[i][j].
+template <class V>
+struct Mat3 {
+  V r[3][3];
+};
+
+/// The rotation of a unit quaternion (w, x, y, z).
+template <class V>
+inline Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z) {
+  const V two(2), one(1);
+  const V xx = x * x, yy = y * y, zz = z * z;
+  const V xy = x * y, xz = x * z, yz = y * z;
+  const V wx = w * x, wy = w * y, wz = w * z;
+  Mat3<V> m;
+  m.r[0][0] = one - two * (yy + zz);
+  m.r[0][1] = two * (xy - wz);
+  m.r[0][2] = two * (xz + wy);
+  m.r[1][0] = two * (xy + wz);
+  m.r[1][1] = one - two * (xx + zz);
+  m.r[1][2] = two * (yz - wx);
+  m.r[2][0] = two * (xz - wy);
+  m.r[2][1] = two * (yz + wx);
+  m.r[2][2] = one - two * (xx + yy);
+  return m;
+}
+
+/// R v: body frame to world frame.
+template <class V>
+inline Vec3<V> to_world(const Mat3<V>& m, const Vec3<V>& v) {
+  return {m.r[0][0] * v.x + m.r[0][1] * v.y + m.r[0][2] * v.z, m.r[1][0] * v.x + m.r[1][1] * v.y + m.r[1][2] * v.z,
+          m.r[2][0] * v.x + m.r[2][1] * v.y + m.r[2][2] * v.z};
+}
+
+/// R^T v: world frame to body frame.
+template <class V>
+inline Vec3<V> to_body(const Mat3<V>& m, const Vec3<V>& v) {
+  return {m.r[0][0] * v.x + m.r[1][0] * v.y + m.r[2][0] * v.z, m.r[0][1] * v.x + m.r[1][1] * v.y + m.r[2][1] * v.z,
+          m.r[0][2] * v.x + m.r[1][2] * v.y + m.r[2][2] * v.z};
+}
+
+}  // namespace collide::detail

@@ -1,0 +1,127 @@
+// reference.cpp - the law of docs/collision-law.md, transcribed.
+//
+// World frame, Eigen 3x3 matrices, Iw^-1 = R diag(1/I) R^T, contacts in input
+// order. No lanes and no local-frame shortcut: this is the independent
+// statement that the local-frame kernel is checked against. It reads the same
+// stored inputs as the kernels (inverse mass, inverse moments, q, n as given)
+// so that a difference measures the kernel's arithmetic, not input rounding;
+// q is normalised here in S, as the law writes R(q / |q|).
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include "collide/reference.hpp"
+
+namespace collide {
+namespace {
+
+template <class S>
+struct RefBody {
+  using V3 = Eigen::Matrix<S, 3, 1>;
+  using M3 = Eigen::Matrix<S, 3, 3>;
+  S inv_mass;
+  M3 inv_inertia_world;
+  V3 p, v, w;
+
+  RefBody(const BodyView<S>& bodies, std::size_t i) {
+    inv_mass = bodies.inv_mass[i];
+    // The law: a body with m = inf is immovable whatever its I.
+    const bool immovable = inv_mass == S(0);
+    const V3 inv_i = immovable ? V3::Zero()
+                               : V3(bodies.inv_inertia.x[i], bodies.inv_inertia.y[i], bodies.inv_inertia.z[i]);
+    const Eigen::Quaternion<S> q =
+        Eigen::Quaternion<S>(bodies.q.w[i], bodies.q.x[i], bodies.q.y[i], bodies.q.z[i]).normalized();
+    const M3 r = q.toRotationMatrix();
+    inv_inertia_world = r * inv_i.asDiagonal() * r.transpose();
+    p = V3(bodies.p.x[i], bodies.p.y[i], bodies.p.z[i]);
+    v = V3(bodies.v.x[i], bodies.v.y[i], bodies.v.z[i]);
+    w = V3(bodies.w.x[i], bodies.w.y[i], bodies.w.z[i]);
+  }
+
+  void store(const BodyView<S>& bodies, std::size_t i) const {
+    if (inv_mass == S(0)) return;  // immovable bodies are never written
+    bodies.v.x[i] = v.x();
+    bodies.v.y[i] = v.y();
+    bodies.v.z[i] = v.z();
+    bodies.w.x[i] = w.x();
+    bodies.w.y[i] = w.y();
+    bodies.w.z[i] = w.z();
+  }
+};
+
+}  // namespace
+
+template <class S>
+void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
+                     ReferenceContact<S>* diagnostics) {
+  using V3 = Eigen::Matrix<S, 3, 1>;
+  for (std::size_t k = 0; k < contacts.count; ++k) {
+    const std::size_t ia = contacts.a[k];
+    const std::size_t ib = contacts.b[k];
+    RefBody<S> a(bodies, ia);
+    RefBody<S> b(bodies, ib);
+    const V3 c(contacts.c.x[k], contacts.c.y[k], contacts.c.z[k]);
+    const V3 n(contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]);
+    const S e = contacts.e ? contacts.e[k] : contacts.uniform_e;
+    const S mu = contacts.mu ? contacts.mu[k] : S(0);
+
+    const V3 ra = c - a.p;
+    const V3 rb = c - b.p;
+    auto relative_velocity = [&] { return V3((a.v + a.w.cross(ra)) - (b.v + b.w.cross(rb))); };
+    auto speed_scale = [&] {
+      return a.v.norm() + a.w.norm() * ra.norm() + b.v.norm() + b.w.norm() * rb.norm();
+    };
+    auto inv_effective_mass = [&](const V3& d) {
+      const V3 rad = ra.cross(d);
+      const V3 rbd = rb.cross(d);
+      return a.inv_mass + b.inv_mass + rad.dot(a.inv_inertia_world * rad) + rbd.dot(b.inv_inertia_world * rbd);
+    };
+    auto apply = [&](const V3& p) {
+      a.v += p * a.inv_mass;
+      a.w += a.inv_inertia_world * ra.cross(p);
+      b.v -= p * b.inv_mass;
+      b.w -= b.inv_inertia_world * rb.cross(p);
+    };
+
+    ReferenceContact<S> d;
+    const V3 u = relative_velocity();
+    d.vn = u.dot(n);
+    d.speed_scale = speed_scale();
+    d.k_n = inv_effective_mass(n);
+    V3 j = V3::Zero();
+    if (d.vn < S(0) && d.k_n != S(0)) {
+      d.jn = -(S(1) + e) * d.vn / d.k_n;
+      apply(d.jn * n);
+      j = d.jn * n;
+      d.impulse_scale = (S(1) + e) * d.speed_scale / d.k_n;
+      if (mu > S(0)) {
+        const V3 u2 = relative_velocity();
+        const V3 ut = u2 - u2.dot(n) * n;
+        const S ut_len = ut.norm();
+        if (ut_len > S(0)) {
+          const V3 t = ut / ut_len;
+          d.k_t = inv_effective_mass(t);
+          d.jt = std::min(ut_len / d.k_t, mu * d.jn);
+          d.impulse_scale += speed_scale() / d.k_t;
+          apply(-d.jt * t);
+          j -= d.jt * t;
+        }
+      }
+      a.store(bodies, ia);
+      b.store(bodies, ib);
+    }
+    impulses.j.x[k] = j.x();
+    impulses.j.y[k] = j.y();
+    impulses.j.z[k] = j.z();
+    if (diagnostics) diagnostics[k] = d;
+  }
+}
+
+template void reference_solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&,
+                                      ReferenceContact<double>*);
+template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
+                                           const ImpulseView<long double>&, ReferenceContact<long double>*);
+
+}  // namespace collide

@@ -1,0 +1,206 @@
+// scene.cpp - the owning SoA buffers of bodies.hpp and contacts.hpp.
+//
+// The only arithmetic here is the conversion from scene-file units to what the
+// kernel consumes: 1/m, 1/I (0 for inf), q / |q| and n / |n|. It is done once,
+// at the boundary, so that the kernels never divide by a mass.
+#include <cmath>
+#include <limits>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+
+namespace collide {
+namespace {
+
+// 1/x with 1/inf = 0 (an immovable body or a locked axis).
+template <class T>
+T inverse_or_zero(T x) {
+  return std::isinf(x) ? T(0) : T(1) / x;
+}
+
+// 1/x with 1/0 = inf, the inverse of inverse_or_zero.
+template <class T>
+T inverse_or_inf(T x) {
+  return x == T(0) ? std::numeric_limits<T>::infinity() : T(1) / x;
+}
+
+}  // namespace
+
+template <class T>
+void BodyBuffer<T>::resize(std::size_t n) {
+  for (auto* v : {&inv_mass_, &ix_, &iy_, &iz_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_,
+                  &wz_}) {
+    v->resize(n, T(0));
+  }
+  qw_.resize(n, T(1));
+}
+
+template <class T>
+void BodyBuffer<T>::reserve(std::size_t n) {
+  for (auto* v : {&inv_mass_, &ix_, &iy_, &iz_, &qw_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_,
+                  &wy_, &wz_}) {
+    v->reserve(n);
+  }
+}
+
+template <class T>
+void BodyBuffer<T>::push_back(const BodyRecord<T>& body) {
+  resize(size() + 1);
+  set(size() - 1, body);
+}
+
+template <class T>
+void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
+  const T inv_m = inverse_or_zero(body.m);
+  const bool immovable = inv_m == T(0);
+  inv_mass_[i] = inv_m;
+  // The law: "a body with m = inf is immovable whatever its I".
+  ix_[i] = immovable ? T(0) : inverse_or_zero(body.I[0]);
+  iy_[i] = immovable ? T(0) : inverse_or_zero(body.I[1]);
+  iz_[i] = immovable ? T(0) : inverse_or_zero(body.I[2]);
+  const T qn = std::sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
+  qw_[i] = body.q[0] / qn;
+  qx_[i] = body.q[1] / qn;
+  qy_[i] = body.q[2] / qn;
+  qz_[i] = body.q[3] / qn;
+  px_[i] = body.p[0];
+  py_[i] = body.p[1];
+  pz_[i] = body.p[2];
+  vx_[i] = body.v[0];
+  vy_[i] = body.v[1];
+  vz_[i] = body.v[2];
+  wx_[i] = body.w[0];
+  wy_[i] = body.w[1];
+  wz_[i] = body.w[2];
+}
+
+template <class T>
+BodyRecord<T> BodyBuffer<T>::record(std::size_t i) const {
+  BodyRecord<T> r;
+  r.m = inverse_or_inf(inv_mass_[i]);
+  r.I[0] = inverse_or_inf(ix_[i]);
+  r.I[1] = inverse_or_inf(iy_[i]);
+  r.I[2] = inverse_or_inf(iz_[i]);
+  r.q[0] = qw_[i];
+  r.q[1] = qx_[i];
+  r.q[2] = qy_[i];
+  r.q[3] = qz_[i];
+  r.p[0] = px_[i];
+  r.p[1] = py_[i];
+  r.p[2] = pz_[i];
+  r.v[0] = vx_[i];
+  r.v[1] = vy_[i];
+  r.v[2] = vz_[i];
+  r.w[0] = wx_[i];
+  r.w[1] = wy_[i];
+  r.w[2] = wz_[i];
+  return r;
+}
+
+template <class T>
+BodyView<T> BodyBuffer<T>::view() {
+  return {size(),
+          inv_mass_.data(),
+          {ix_.data(), iy_.data(), iz_.data()},
+          {qw_.data(), qx_.data(), qy_.data(), qz_.data()},
+          {px_.data(), py_.data(), pz_.data()},
+          {vx_.data(), vy_.data(), vz_.data()},
+          {wx_.data(), wy_.data(), wz_.data()}};
+}
+
+template <class T>
+BodyView<const T> BodyBuffer<T>::view() const {
+  return {size(),
+          inv_mass_.data(),
+          {ix_.data(), iy_.data(), iz_.data()},
+          {qw_.data(), qx_.data(), qy_.data(), qz_.data()},
+          {px_.data(), py_.data(), pz_.data()},
+          {vx_.data(), vy_.data(), vz_.data()},
+          {wx_.data(), wy_.data(), wz_.data()}};
+}
+
+template <class T>
+void ContactBuffer<T>::resize(std::size_t n) {
+  a_.resize(n, 0);
+  b_.resize(n, 0);
+  for (auto* v : {&cx_, &cy_, &cz_, &nx_, &ny_, &e_, &mu_}) {
+    v->resize(n, T(0));
+  }
+  nz_.resize(n, T(1));
+}
+
+template <class T>
+void ContactBuffer<T>::reserve(std::size_t n) {
+  a_.reserve(n);
+  b_.reserve(n);
+  for (auto* v : {&cx_, &cy_, &cz_, &nx_, &ny_, &nz_, &e_, &mu_}) {
+    v->reserve(n);
+  }
+}
+
+template <class T>
+void ContactBuffer<T>::push_back(const ContactRecord<T>& contact) {
+  resize(size() + 1);
+  set(size() - 1, contact);
+}
+
+template <class T>
+void ContactBuffer<T>::set(std::size_t i, const ContactRecord<T>& contact) {
+  a_[i] = contact.a;
+  b_[i] = contact.b;
+  cx_[i] = contact.c[0];
+  cy_[i] = contact.c[1];
+  cz_[i] = contact.c[2];
+  const T nn = std::sqrt(contact.n[0] * contact.n[0] + contact.n[1] * contact.n[1] + contact.n[2] * contact.n[2]);
+  nx_[i] = contact.n[0] / nn;
+  ny_[i] = contact.n[1] / nn;
+  nz_[i] = contact.n[2] / nn;
+  e_[i] = contact.e;
+  mu_[i] = contact.mu;
+}
+
+template <class T>
+ContactRecord<T> ContactBuffer<T>::record(std::size_t i) const {
+  ContactRecord<T> r;
+  r.a = a_[i];
+  r.b = b_[i];
+  r.c[0] = cx_[i];
+  r.c[1] = cy_[i];
+  r.c[2] = cz_[i];
+  r.n[0] = nx_[i];
+  r.n[1] = ny_[i];
+  r.n[2] = nz_[i];
+  r.e = e_[i];
+  r.mu = mu_[i];
+  return r;
+}
+
+template <class T>
+bool ContactBuffer<T>::has_friction() const {
+  for (const T mu : mu_) {
+    if (mu > T(0)) return true;
+  }
+  return false;
+}
+
+template <class T>
+ContactView<T> ContactBuffer<T>::view() const {
+  ContactView<T> v;
+  v.count = size();
+  v.a = a_.data();
+  v.b = b_.data();
+  v.c = {cx_.data(), cy_.data(), cz_.data()};
+  v.n = {nx_.data(), ny_.data(), nz_.data()};
+  v.e = e_.data();
+  v.mu = has_friction() ? mu_.data() : nullptr;
+  return v;
+}
+
+template class BodyBuffer<float>;
+template class BodyBuffer<double>;
+template class BodyBuffer<long double>;
+template class ContactBuffer<float>;
+template class ContactBuffer<double>;
+template class ContactBuffer<long double>;
+
+}  // namespace collide
