@@ -73,7 +73,7 @@ struct ContactResult {
 
 /// Immovable bodies have no rotational response either, whatever they store.
 template <class V>
-inline void zero_immovable_inertia(BodyLanes<V>& body) {
+COLLIDE_LANE_INLINE void zero_immovable_inertia(BodyLanes<V>& body) {
   const auto immovable = body.inv_mass == V(0);
   stdx::where(immovable, body.inv_inertia.x) = V(0);
   stdx::where(immovable, body.inv_inertia.y) = V(0);
@@ -82,7 +82,7 @@ inline void zero_immovable_inertia(BodyLanes<V>& body) {
 
 /// Relative velocity of a's contact point with respect to b's.
 template <class V>
-inline Vec3<V> relative_velocity(const BodyLanes<V>& a, const BodyLanes<V>& b, const Vec3<V>& ra,
+COLLIDE_LANE_INLINE Vec3<V> relative_velocity(const BodyLanes<V>& a, const BodyLanes<V>& b, const Vec3<V>& ra,
                                  const Vec3<V>& rb) {
   return (a.v + cross(a.w, ra)) - (b.v + cross(b.w, rb));
 }
@@ -95,7 +95,7 @@ struct LeverArm {
 };
 
 template <class V>
-inline LeverArm<V> lever_arm(const BodyLanes<V>& body, const Vec3<V>& r, const Vec3<V>& d) {
+COLLIDE_LANE_INLINE LeverArm<V> lever_arm(const BodyLanes<V>& body, const Vec3<V>& r, const Vec3<V>& d) {
   const Vec3<V> h = to_body(body.rotation, cross(r, d));
   const Vec3<V> response = hadamard(body.inv_inertia, h);
   return {response, dot(h, response)};
@@ -104,7 +104,7 @@ inline LeverArm<V> lever_arm(const BodyLanes<V>& body, const Vec3<V>& r, const V
 /// Applies the impulse s * d to a (and -s * d to b) where `active`, given the
 /// lever arms of d. Inactive lanes keep their velocities bit for bit.
 template <class V>
-inline void apply_impulse(BodyLanes<V>& a, BodyLanes<V>& b, const Vec3<V>& d, const V& s, const LeverArm<V>& arm_a,
+COLLIDE_LANE_INLINE void apply_impulse(BodyLanes<V>& a, BodyLanes<V>& b, const Vec3<V>& d, const V& s, const LeverArm<V>& arm_a,
                           const LeverArm<V>& arm_b, const typename V::mask_type& active) {
   const Vec3<V> p = d * s;
   a.v = select(active, a.v + p * a.inv_mass, a.v);
@@ -116,7 +116,7 @@ inline void apply_impulse(BodyLanes<V>& a, BodyLanes<V>& b, const Vec3<V>& d, co
 /// The law for W contacts whose bodies are pairwise distinct (or immovable).
 /// kFriction selects the Coulomb step; without it `mu` is never read.
 template <class V, bool kFriction>
-inline ContactResult<V> resolve_contacts(BodyLanes<V>& a, BodyLanes<V>& b, const ContactLanes<V>& contact) {
+COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<V>& a, BodyLanes<V>& b, const ContactLanes<V>& contact) {
   zero_immovable_inertia(a);
   zero_immovable_inertia(b);
   const Vec3<V>& n = contact.n;

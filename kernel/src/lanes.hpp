@@ -14,10 +14,10 @@
 // `where`, costs no dependency, and produced the same inner loop as
 // intrinsics in our measurement (README, "Choosing the lane layer").
 //
-// AVX2 has gathers but no scatters, and on the AMD Zen cores we run on a
-// vgatherdps is no faster than scalar loads, so gather() is a generator
-// constructor (W scalar loads) and scatter() W scalar stores; the compiler
-// builds the vectors with inserts.
+// AVX2 has gathers but no scatters. On the AMD Zen 4 we measure on, the
+// pairs scene ran 20% slower with vgatherdps than with W scalar loads and
+// inserts (64k contacts, float, 1 thread: 44 vs 54 M contacts/s), so gather()
+// is a generator constructor (W scalar loads) and scatter() W scalar stores.
 //
 // Floating point: every operation here is an IEEE add, sub, mul, div, sqrt,
 // min or compare, each correctly rounded; with -ffp-contract=off nothing is
@@ -27,6 +27,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <experimental/simd>
+
+// Everything a kernel body calls is forced inline: GCC's heuristics give up
+// on functions that take several 8-lane structs, and an out-of-line call
+// passes them through memory (measured: a third of the time in gather_body).
+#define COLLIDE_LANE_INLINE inline __attribute__((always_inline))
 
 namespace collide::detail {
 
@@ -39,7 +44,7 @@ using SimdLanes = stdx::native_simd<T>;
 
 /// b where the mask is false, a where it is true.
 template <class V>
-inline V select(const typename V::mask_type& m, const V& a, const V& b) {
+COLLIDE_LANE_INLINE V select(const typename V::mask_type& m, const V& a, const V& b) {
   V r = b;
   stdx::where(m, r) = a;
   return r;
@@ -47,24 +52,24 @@ inline V select(const typename V::mask_type& m, const V& a, const V& b) {
 
 /// W consecutive values starting at p.
 template <class V>
-inline V load(const typename V::value_type* p) {
+COLLIDE_LANE_INLINE V load(const typename V::value_type* p) {
   return V(p, stdx::element_aligned);
 }
 
 template <class V>
-inline void store(const V& v, typename V::value_type* p) {
+COLLIDE_LANE_INLINE void store(const V& v, typename V::value_type* p) {
   v.copy_to(p, stdx::element_aligned);
 }
 
 /// base[idx[0]], ..., base[idx[W-1]].
 template <class V, class Index>
-inline V gather(const typename V::value_type* base, const Index* idx) {
+COLLIDE_LANE_INLINE V gather(const typename V::value_type* base, const Index* idx) {
   return V([&](auto lane) { return base[idx[lane]]; });
 }
 
 /// base[idx[l]] = v[l] for every lane l whose `write` is true.
 template <class V, class Index>
-inline void scatter(const V& v, typename V::value_type* base, const Index* idx, const typename V::mask_type& write) {
+COLLIDE_LANE_INLINE void scatter(const V& v, typename V::value_type* base, const Index* idx, const typename V::mask_type& write) {
   for (std::size_t l = 0; l < V::size(); ++l) {
     if (write[l]) base[idx[l]] = v[l];
   }
@@ -77,32 +82,32 @@ struct Vec3 {
 };
 
 template <class V>
-inline Vec3<V> operator+(const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE Vec3<V> operator+(const Vec3<V>& a, const Vec3<V>& b) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
 template <class V>
-inline Vec3<V> operator-(const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE Vec3<V> operator-(const Vec3<V>& a, const Vec3<V>& b) {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
 template <class V>
-inline Vec3<V> operator*(const Vec3<V>& a, const V& s) {
+COLLIDE_LANE_INLINE Vec3<V> operator*(const Vec3<V>& a, const V& s) {
   return {a.x * s, a.y * s, a.z * s};
 }
 /// Component-wise product (diagonal matrix times vector).
 template <class V>
-inline Vec3<V> hadamard(const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE Vec3<V> hadamard(const Vec3<V>& a, const Vec3<V>& b) {
   return {a.x * b.x, a.y * b.y, a.z * b.z};
 }
 template <class V>
-inline V dot(const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE V dot(const Vec3<V>& a, const Vec3<V>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 template <class V>
-inline Vec3<V> cross(const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE Vec3<V> cross(const Vec3<V>& a, const Vec3<V>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 template <class V>
-inline Vec3<V> select(const typename V::mask_type& m, const Vec3<V>& a, const Vec3<V>& b) {
+COLLIDE_LANE_INLINE Vec3<V> select(const typename V::mask_type& m, const Vec3<V>& a, const Vec3<V>& b) {
   return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
 }
 
@@ -114,7 +119,7 @@ struct Mat3 {
 
 /// The rotation of a unit quaternion (w, x, y, z).
 template <class V>
-inline Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z) {
+COLLIDE_LANE_INLINE Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z) {
   const V two(2), one(1);
   const V xx = x * x, yy = y * y, zz = z * z;
   const V xy = x * y, xz = x * z, yz = y * z;
@@ -134,14 +139,14 @@ inline Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z) {
 
 /// R v: body frame to world frame.
 template <class V>
-inline Vec3<V> to_world(const Mat3<V>& m, const Vec3<V>& v) {
+COLLIDE_LANE_INLINE Vec3<V> to_world(const Mat3<V>& m, const Vec3<V>& v) {
   return {m.r[0][0] * v.x + m.r[0][1] * v.y + m.r[0][2] * v.z, m.r[1][0] * v.x + m.r[1][1] * v.y + m.r[1][2] * v.z,
           m.r[2][0] * v.x + m.r[2][1] * v.y + m.r[2][2] * v.z};
 }
 
 /// R^T v: world frame to body frame.
 template <class V>
-inline Vec3<V> to_body(const Mat3<V>& m, const Vec3<V>& v) {
+COLLIDE_LANE_INLINE Vec3<V> to_body(const Mat3<V>& m, const Vec3<V>& v) {
   return {m.r[0][0] * v.x + m.r[1][0] * v.y + m.r[2][0] * v.z, m.r[0][1] * v.x + m.r[1][1] * v.y + m.r[2][1] * v.z,
           m.r[0][2] * v.x + m.r[1][2] * v.y + m.r[2][2] * v.z};
 }

@@ -45,12 +45,12 @@ struct ContactGroup {
 };
 
 template <class V, class T>
-inline V contact_field(const T* field, const ContactGroup& g) {
+COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
 template <class V, class T>
-inline void gather_body(const BodyView<T>& bodies, const BodyIndex* ids, BodyLanes<V>& out) {
+COLLIDE_LANE_INLINE void gather_body(const BodyView<T>& bodies, const BodyIndex* ids, BodyLanes<V>& out) {
   out.inv_mass = gather<V>(bodies.inv_mass, ids);
   out.inv_inertia = {gather<V>(bodies.inv_inertia.x, ids), gather<V>(bodies.inv_inertia.y, ids),
                      gather<V>(bodies.inv_inertia.z, ids)};
@@ -62,7 +62,7 @@ inline void gather_body(const BodyView<T>& bodies, const BodyIndex* ids, BodyLan
 }
 
 template <class V, class T>
-inline void scatter_body(const BodyLanes<V>& body, const BodyView<T>& bodies, const BodyIndex* ids) {
+COLLIDE_LANE_INLINE void scatter_body(const BodyLanes<V>& body, const BodyView<T>& bodies, const BodyIndex* ids) {
   const auto movable = body.inv_mass != V(0);
   scatter(body.v.x, bodies.v.x, ids, movable);
   scatter(body.v.y, bodies.v.y, ids, movable);
@@ -74,7 +74,7 @@ inline void scatter_body(const BodyLanes<V>& body, const BodyView<T>& bodies, co
 
 /// Resolves one group of V::size() contacts.
 template <class V, bool kFriction, class T>
-inline void solve_group(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                         const ContactGroup& g) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
