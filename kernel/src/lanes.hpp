@@ -27,6 +27,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <experimental/simd>
+#include <type_traits>
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
 
 // Everything a kernel body calls is forced inline: GCC's heuristics give up
 // on functions that take several 8-lane structs, and an out-of-line call
@@ -72,6 +76,59 @@ template <class V, class Index>
 COLLIDE_LANE_INLINE void scatter(const V& v, typename V::value_type* base, const Index* idx, const typename V::mask_type& write) {
   for (std::size_t l = 0; l < V::size(); ++l) {
     if (write[l]) base[idx[l]] = v[l];
+  }
+}
+
+/// Loads 2W consecutive values p[0..2W) and splits them into the even ones
+/// (p[0], p[2], ...) and the odd ones (p[1], p[3], ...): the bodies of W
+/// contacts laid out as pairs (2k, 2k+1), loaded with two vector loads.
+template <class V>
+COLLIDE_LANE_INLINE void load_deinterleaved(const typename V::value_type* p, V& even, V& odd) {
+#if defined(__AVX2__)
+  if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 8) {
+    const __m256 lo = _mm256_loadu_ps(p);
+    const __m256 hi = _mm256_loadu_ps(p + 8);
+    // Per 128-bit half: evens of lo, then evens of hi; then fix the halves.
+    const __m256 e = _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0));
+    const __m256 o = _mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1));
+    even = V(_mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(e), _MM_SHUFFLE(3, 1, 2, 0))));
+    odd = V(_mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(o), _MM_SHUFFLE(3, 1, 2, 0))));
+    return;
+  } else if constexpr (std::is_same_v<V, SimdLanes<double>> && V::size() == 4) {
+    const __m256d lo = _mm256_loadu_pd(p);
+    const __m256d hi = _mm256_loadu_pd(p + 4);
+    even = V(_mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), _MM_SHUFFLE(3, 1, 2, 0)));
+    odd = V(_mm256_permute4x64_pd(_mm256_unpackhi_pd(lo, hi), _MM_SHUFFLE(3, 1, 2, 0)));
+    return;
+  }
+#endif
+  even = V([&](auto lane) { return p[2 * lane]; });
+  odd = V([&](auto lane) { return p[2 * lane + 1]; });
+}
+
+/// The inverse of load_deinterleaved: p[2l] = even[l], p[2l+1] = odd[l].
+template <class V>
+COLLIDE_LANE_INLINE void store_interleaved(const V& even, const V& odd, typename V::value_type* p) {
+#if defined(__AVX2__)
+  if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 8) {
+    const __m256 e = _mm256_castpd_ps(
+        _mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(even)), _MM_SHUFFLE(3, 1, 2, 0)));
+    const __m256 o = _mm256_castpd_ps(
+        _mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(odd)), _MM_SHUFFLE(3, 1, 2, 0)));
+    _mm256_storeu_ps(p, _mm256_unpacklo_ps(e, o));
+    _mm256_storeu_ps(p + 8, _mm256_unpackhi_ps(e, o));
+    return;
+  } else if constexpr (std::is_same_v<V, SimdLanes<double>> && V::size() == 4) {
+    const __m256d e = _mm256_permute4x64_pd(static_cast<__m256d>(even), _MM_SHUFFLE(3, 1, 2, 0));
+    const __m256d o = _mm256_permute4x64_pd(static_cast<__m256d>(odd), _MM_SHUFFLE(3, 1, 2, 0));
+    _mm256_storeu_pd(p, _mm256_unpacklo_pd(e, o));
+    _mm256_storeu_pd(p + 4, _mm256_unpackhi_pd(e, o));
+    return;
+  }
+#endif
+  for (std::size_t l = 0; l < V::size(); ++l) {
+    p[2 * l] = even[l];
+    p[2 * l + 1] = odd[l];
   }
 }
 

@@ -72,6 +72,60 @@ COLLIDE_LANE_INLINE void scatter_body(const BodyLanes<V>& body, const BodyView<T
   scatter(body.w.z, bodies.w.z, ids, movable);
 }
 
+/// The streaming-pairs layout: contact l of the group joins bodies
+/// first + 2l and first + 2l + 1, so both sides come from 2W consecutive
+/// bodies (two vector loads and a deinterleave per field, instead of 2W
+/// scalar loads). This is how a caller lays out independent pairs, and how
+/// the pairs scene is built; any other layout takes the general gather.
+template <std::size_t W>
+COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* ib) {
+  bool paired = true;
+  for (std::size_t l = 0; l < W; ++l) {
+    paired &= (ia[l] == ia[0] + 2 * l) & (ib[l] == ia[l] + 1);
+  }
+  return paired;
+}
+
+template <class V, class T>
+COLLIDE_LANE_INLINE void load_pair_field(const T* field, BodyIndex first, V& a, V& b) {
+  load_deinterleaved<V>(field + first, a, b);
+}
+
+template <class V, class T>
+COLLIDE_LANE_INLINE void gather_paired(const BodyView<T>& bodies, BodyIndex first, BodyLanes<V>& a, BodyLanes<V>& b) {
+  load_pair_field(bodies.inv_mass, first, a.inv_mass, b.inv_mass);
+  load_pair_field(bodies.inv_inertia.x, first, a.inv_inertia.x, b.inv_inertia.x);
+  load_pair_field(bodies.inv_inertia.y, first, a.inv_inertia.y, b.inv_inertia.y);
+  load_pair_field(bodies.inv_inertia.z, first, a.inv_inertia.z, b.inv_inertia.z);
+  V qwa, qxa, qya, qza, qwb, qxb, qyb, qzb;
+  load_pair_field(bodies.q.w, first, qwa, qwb);
+  load_pair_field(bodies.q.x, first, qxa, qxb);
+  load_pair_field(bodies.q.y, first, qya, qyb);
+  load_pair_field(bodies.q.z, first, qza, qzb);
+  a.rotation = rotation(qwa, qxa, qya, qza);
+  b.rotation = rotation(qwb, qxb, qyb, qzb);
+  load_pair_field(bodies.p.x, first, a.p.x, b.p.x);
+  load_pair_field(bodies.p.y, first, a.p.y, b.p.y);
+  load_pair_field(bodies.p.z, first, a.p.z, b.p.z);
+  load_pair_field(bodies.v.x, first, a.v.x, b.v.x);
+  load_pair_field(bodies.v.y, first, a.v.y, b.v.y);
+  load_pair_field(bodies.v.z, first, a.v.z, b.v.z);
+  load_pair_field(bodies.w.x, first, a.w.x, b.w.x);
+  load_pair_field(bodies.w.y, first, a.w.y, b.w.y);
+  load_pair_field(bodies.w.z, first, a.w.z, b.w.z);
+}
+
+template <class V, class T>
+COLLIDE_LANE_INLINE void scatter_paired(const BodyLanes<V>& a, const BodyLanes<V>& b, const BodyView<T>& bodies,
+                                        BodyIndex first) {
+  store_interleaved(a.v.x, b.v.x, bodies.v.x + first);
+  store_interleaved(a.v.y, b.v.y, bodies.v.y + first);
+  store_interleaved(a.v.z, b.v.z, bodies.v.z + first);
+  store_interleaved(a.w.x, b.w.x, bodies.w.x + first);
+  store_interleaved(a.w.y, b.w.y, bodies.w.y + first);
+  store_interleaved(a.w.z, b.w.z, bodies.w.z + first);
+}
+
 /// Resolves one group of V::size() contacts.
 template <class V, bool kFriction, class T>
 COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
@@ -85,10 +139,17 @@ COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactVie
     ib[l] = contacts.b[k];
     assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
   }
+  // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
+  // would gain nothing. The arithmetic is the same either way.
+  const bool paired = W > 1 && is_paired_layout<W>(ia, ib);
   BodyLanes<V> a;
   BodyLanes<V> b;
-  gather_body(bodies, ia, a);
-  gather_body(bodies, ib, b);
+  if (paired) {
+    gather_paired(bodies, ia[0], a, b);
+  } else {
+    gather_body(bodies, ia, a);
+    gather_body(bodies, ib, b);
+  }
 
   ContactLanes<V> c;
   c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
@@ -98,8 +159,14 @@ COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactVie
 
   const ContactResult<V> r = resolve_contacts<V, kFriction>(a, b, c);
 
-  scatter_body(a, bodies, ia);
-  scatter_body(b, bodies, ib);
+  // An immovable body is never written, not even with its own value: another
+  // thread may be reading it (the ground is in many contacts of a batch).
+  if (paired && stdx::all_of((a.inv_mass != V(0)) && (b.inv_mass != V(0)))) {
+    scatter_paired(a, b, bodies, ia[0]);
+  } else {
+    scatter_body(a, bodies, ia);
+    scatter_body(b, bodies, ib);
+  }
   if (g.contiguous) {
     store(r.j.x, impulses.j.x + g.first);
     store(r.j.y, impulses.j.y + g.first);
