@@ -1,0 +1,40 @@
+// collide/validate.hpp - checking views before they reach a kernel.
+//
+// The kernels trust their input: in release builds they check nothing, in
+// debug builds they assert the cheap preconditions (index range, a != b, view
+// sizes). A caller that hands over its own arrays calls validate() at the
+// boundary, once per scene or whenever the data may be bad; the CLI's file
+// reader applies the stricter scene-file rules of docs/collision-law.md.
+#pragma once
+
+#include <string>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+
+namespace collide {
+
+/// The first problem found, or ok.
+struct Validation {
+  bool ok = true;
+  std::string message;  ///< names the view, the field and the element, e.g. "contacts.b[17] = 40: out of range"
+  explicit operator bool() const { return ok; }
+};
+
+/// Checks what the kernels assume:
+///  * every non-null view has its arrays (no null pointer with count > 0);
+///  * impulses.count == contacts.count;
+///  * contact indices < bodies.count and a != b;
+///  * inverse mass and inverse moments finite and >= 0;
+///  * q, p, v, w, c, n finite; |q| and |n| equal to 1 within 1e-4 (the
+///    kernels do not renormalise);
+///  * e in [0, 1] (per contact, or uniform_e), mu finite and >= 0.
+template <class T>
+Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
+
+extern template Validation validate<float>(const BodyView<float>&, const ContactView<float>&,
+                                           const ImpulseView<float>&);
+extern template Validation validate<double>(const BodyView<double>&, const ContactView<double>&,
+                                            const ImpulseView<double>&);
+
+}  // namespace collide
