@@ -1,0 +1,674 @@
+// bench/main.cpp - collide_bench: throughput, bandwidth fraction and memory of
+// the collision kernels, with a summary of the README's targets.
+//
+// Design notes
+// ------------
+// What runs, in this order (Google Benchmark runs rows in registration order):
+//   triad/t:{1,2}                         memory bandwidth, the bound (triad.cpp)
+//   then, for each scene x precision x N, one group:
+//     schedule/<scene>/<f32|f64>/n:N      Schedule::build alone
+//     solve/<scene>/<prec>/<scalar|simd>/t:{1,2}/n:N
+//     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp)
+// Scenes: pairs (collide::generate_pairs: contact k joins bodies 2k, 2k+1),
+// debris (collide::generate_debris: N/2 movable bodies shared at random plus
+// one immovable ground under 25% of the contacts), and pairs+mu (pairs with
+// friction, at the two target sizes only). N counts contacts.
+//
+// Timing is honest about the state the solve starts from:
+//   * Every solve starts from the same velocities. A solve changes v and w, and
+//     a second solve of the same scene would see separating contacts, which a
+//     branching scalar path resolves more cheaply. So before every timed solve
+//     the velocities are restored from a saved copy with memcpy, and only the
+//     solve itself is timed, with steady_clock around the one call
+//     (UseManualTime). Reading the clock costs tens of nanoseconds against at
+//     least tens of microseconds for the smallest solve, and unlike
+//     PauseTiming/ResumeTiming it does not distort small N.
+//   * For a scene that does not fit in the last-level cache, the restore would
+//     leave up to an LLC of dirty velocity lines for the timed solve to write
+//     back, and a tail of warm lines; so between the restore and the timed
+//     solve such scenes stream 4x the LLC through the caches (untimed). The
+//     solve then starts cold, as a solve of a large scene does every frame.
+//     A scene that fits in the LLC is solved warm, which is what it would be.
+//   * The Schedule is built once per scene (untimed, it is reusable) and a
+//     Solver once per row; one untimed solve before the loop starts the
+//     worker threads. Schedule::build has its own rows.
+//   * The CPU column of Google Benchmark is the main thread's CPU time over the
+//     whole loop, restores included: read the Time column (the manual time).
+//
+// Scenes are generated once per (scene, precision, N) and shared by the rows
+// of that group; the group's rows are registered together so that only one
+// scene is alive at a time (at N = 16M in double a pairs scene is ~6 GB).
+//
+// Memory: when a scene is prepared, its buffers are generated, the peak RSS is
+// reset (/proc/self/clear_refs), the schedule is built and one 2-thread SIMD
+// solve runs; the growth of the peak over the RSS before is what the kernel
+// costs beyond the caller's buffers, compared in the summary with the budget
+// of 16 bytes per contact plus 8 per body. peak_MiB on every row is the
+// process's peak RSS since its scene was prepared (buffers, the bench's saved
+// velocities, schedule, threads).
+//
+// Counters (identical on every row so the table has one header; 0 where a
+// column does not apply): coll/s = collisions per second (contacts scheduled
+// per second on schedule rows, elements per second on triad rows); GB/s =
+// coll/s x B/coll; bw_frac = GB/s / triad GB/s at the same thread count;
+// B/coll = bytes of the law's inputs and outputs per collision (support.hpp);
+// batches = schedule batches; sched_B/c = Schedule::memory_bytes() / contacts;
+// peak_MiB = VmHWM.
+//
+// After the run, a summary (this file, print_summary) states the README's
+// ratios from the same run. Flags of our own, removed before Google Benchmark
+// sees argv:
+//   --quick          float only, N in {64Ki, 4Mi}: the rows the targets need
+//   --sizes=a,b,...  the N to run (default 1e4, 64Ki, 256Ki, 1Mi, 4Mi, 16Mi)
+// Any --benchmark_filter gets "|^triad/" appended so that the bound is always
+// measured. The console table is tabular unless --benchmark_counters_tabular=
+// false is given.
+#include <benchmark/benchmark.h>
+#include <malloc.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "collide/generate.hpp"
+#include "collide/scene.hpp"
+#include "collide/schedule.hpp"
+#include "collide/solve.hpp"
+#include "support.hpp"
+#include "textbook.hpp"
+
+namespace collide_bench {
+namespace {
+
+using collide::Path;
+
+// ---------------------------------------------------------------------------
+// Scenes
+// ---------------------------------------------------------------------------
+
+enum class Kind { pairs, debris, pairs_mu };
+
+const char* kind_name(Kind kind) {
+  switch (kind) {
+    case Kind::pairs:
+      return "pairs";
+    case Kind::debris:
+      return "debris";
+    case Kind::pairs_mu:
+      return "pairs+mu";
+  }
+  return "?";
+}
+
+template <class T>
+const char* precision_name() {
+  return sizeof(T) == 4 ? "f32" : "f64";
+}
+
+struct SceneKey {
+  Kind kind = Kind::pairs;
+  std::size_t precision_bytes = 0;
+  std::size_t n = 0;
+  bool operator==(const SceneKey& o) const {
+    return kind == o.kind && precision_bytes == o.precision_bytes && n == o.n;
+  }
+};
+
+/// Memory facts of one prepared scene, kept for the summary.
+struct MemoryRecord {
+  std::string scene;  // "pairs/f32/n:16777216"
+  std::size_t contacts = 0, bodies = 0;
+  double buffer_bytes = 0;    // the caller's buffers: bodies, contacts, impulses
+  double bench_bytes = 0;     // the bench's own: saved v and w, cache-evict buffer
+  double schedule_bytes = 0;  // Schedule::memory_bytes()
+  double extra_bytes = 0;     // peak RSS growth over building the schedule and one solve
+  double peak_rss_bytes = 0;  // VmHWM after that
+  bool peak_was_reset = false;
+};
+std::vector<MemoryRecord> g_memory;
+
+/// A scene ready to solve: buffers, the pristine velocities, the schedule.
+template <class T>
+struct Prepared {
+  SceneKey key;
+  collide::Scene<T> scene;
+  collide::ImpulseBuffer<T> impulses;
+  std::vector<T> saved;  // v.x, v.y, v.z, w.x, w.y, w.z of every body, back to back
+  collide::Schedule schedule;
+  bool friction = false;
+  bool exceeds_llc = false;
+
+  collide::BodyView<T> bodies() { return scene.bodies.view(); }
+  collide::ContactView<T> contacts() const { return scene.contacts.view(); }
+
+  // v.x, v.y, v.z, w.x, w.y, w.z: the arrays a solve writes.
+  std::array<T*, 6> velocity_arrays() {
+    const collide::BodyView<T> b = bodies();
+    return {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
+  }
+  void save() {
+    const std::size_t nb = scene.bodies.size();
+    saved.resize(6 * nb);
+    const std::array<T*, 6> arrays = velocity_arrays();
+    for (std::size_t i = 0; i < 6; ++i) std::memcpy(saved.data() + i * nb, arrays[i], nb * sizeof(T));
+  }
+  void restore() {
+    const std::size_t nb = scene.bodies.size();
+    const std::array<T*, 6> arrays = velocity_arrays();
+    for (std::size_t i = 0; i < 6; ++i) std::memcpy(arrays[i], saved.data() + i * nb, nb * sizeof(T));
+  }
+  /// Untimed preparation of the next timed solve (see the design notes).
+  void reset_for_solve() {
+    restore();
+    if (exceeds_llc) evict_caches();
+  }
+};
+
+template <class T>
+collide::Scene<T> generate(Kind kind, std::size_t n) {
+  collide::GenerateOptions options;
+  options.seed = 1;
+  options.friction = kind == Kind::pairs_mu;
+  return kind == Kind::debris ? collide::generate_debris<T>(n, options) : collide::generate_pairs<T>(n, options);
+}
+
+/// Holds the one scene alive at a time.
+class SceneCache {
+ public:
+  template <class T>
+  Prepared<T>& get(Kind kind, std::size_t n) {
+    const SceneKey key{kind, sizeof(T), n};
+    std::unique_ptr<Prepared<T>>& slot = this->slot<T>();
+    if (slot && slot->key == key) return *slot;
+    // Free the old scene before generating the new one: at 16M both would
+    // not fit side by side in double.
+    float_.reset();
+    double_.reset();
+    // Hand freed heap back to the system so that the next scene's RSS and
+    // peak start from what is really in use.
+    malloc_trim(0);
+    slot = prepare<T>(key);
+    return *slot;
+  }
+
+ private:
+  template <class T>
+  std::unique_ptr<Prepared<T>>& slot() {
+    if constexpr (sizeof(T) == 4) {
+      return float_;
+    } else {
+      return double_;
+    }
+  }
+
+  template <class T>
+  static std::unique_ptr<Prepared<T>> prepare(const SceneKey& key) {
+    auto p = std::make_unique<Prepared<T>>();
+    p->key = key;
+    p->scene = generate<T>(key.kind, key.n);
+    p->friction = p->scene.contacts.view().mu != nullptr;
+    p->impulses.resize(key.n);
+    p->save();
+    const std::size_t bodies = p->scene.bodies.size();
+    p->exceeds_llc = static_cast<double>(key.n) * static_cast<double>(bytes_per_collision<T>(p->friction)) >
+                     static_cast<double>(llc_bytes());
+
+    MemoryRecord record;
+    record.scene = std::string(kind_name(key.kind)) + "/" + precision_name<T>() + "/n:" + std::to_string(key.n);
+    record.contacts = key.n;
+    record.bodies = bodies;
+    record.buffer_bytes = static_cast<double>(bodies * 17 * sizeof(T)) +
+                          static_cast<double>(key.n) * (2 * sizeof(collide::BodyIndex) + 8 * sizeof(T)) +
+                          static_cast<double>(key.n * 3 * sizeof(T));
+    record.bench_bytes = static_cast<double>(p->saved.size() * sizeof(T) + evict_buffer_bytes());
+    const double rss_before = status_bytes("VmRSS");
+    record.peak_was_reset = reset_peak_rss();
+    p->schedule.build(p->contacts(), p->bodies());
+    {
+      collide::SolverOptions options;
+      options.path = Path::simd;
+      options.threads = 2;
+      collide::Solver solver(options);
+      solver.solve(p->bodies(), p->contacts(), p->impulses.view(), p->schedule);
+    }
+    p->restore();
+    record.peak_rss_bytes = status_bytes("VmHWM");
+    record.extra_bytes = record.peak_rss_bytes - rss_before;
+    record.schedule_bytes = static_cast<double>(p->schedule.memory_bytes());
+    g_memory.push_back(record);
+    return p;
+  }
+
+  std::unique_ptr<Prepared<float>> float_;
+  std::unique_ptr<Prepared<double>> double_;
+};
+
+SceneCache g_cache;
+
+// ---------------------------------------------------------------------------
+// Rows
+// ---------------------------------------------------------------------------
+
+std::string solve_name(Kind kind, const char* precision, Path path, int threads, std::size_t n) {
+  return std::string("solve/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(path) +
+         "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
+}
+std::string textbook_name(Kind kind, const char* precision, std::size_t n) {
+  return std::string("textbook/") + kind_name(kind) + "/" + precision + "/t:1/n:" + std::to_string(n);
+}
+std::string schedule_name(Kind kind, const char* precision, std::size_t n) {
+  return std::string("schedule/") + kind_name(kind) + "/" + precision + "/n:" + std::to_string(n);
+}
+
+/// Times `solve_once` with the scene reset before each call (untimed).
+template <class T, class F>
+double timed_solves(benchmark::State& state, Prepared<T>& p, F&& solve_once) {
+  p.reset_for_solve();
+  solve_once();  // warm-up: worker threads started, code and (small) data in cache
+  double seconds = 0;
+  for (auto _ : state) {
+    p.reset_for_solve();
+    const auto t0 = Clock::now();
+    solve_once();
+    const auto t1 = Clock::now();
+    state.SetIterationTime(seconds_between(t0, t1));
+    seconds += seconds_between(t0, t1);
+  }
+  p.restore();
+  return seconds;
+}
+
+template <class T>
+void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int threads) {
+  Prepared<T>& p = g_cache.get<T>(kind, n);
+  collide::SolverOptions options;
+  options.path = path;
+  options.threads = threads;
+  const collide::Solver solver(options);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  collide::SolveStats stats;
+  const double seconds = timed_solves(state, p, [&] { stats = solver.solve(bodies, contacts, impulses, p.schedule); });
+
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(bytes_per_collision<T>(p.friction));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  columns.batches = static_cast<double>(stats.batches);
+  columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+  state.SetLabel(std::to_string(stats.lanes) + " lanes");
+}
+
+template <class T>
+void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
+  Prepared<T>& p = g_cache.get<T>(kind, n);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  const double seconds = timed_solves(state, p, [&] { textbook_solve(bodies, contacts, impulses); });
+
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(bytes_per_collision<T>(p.friction));
+  columns.seconds = seconds;
+  columns.threads = 1;
+  set_counters(state, columns);
+}
+
+template <class T>
+void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
+  Prepared<T>& p = g_cache.get<T>(kind, n);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  // A schedule of its own, built once untimed: later builds reuse its buffers,
+  // as a simulation that rebuilds every frame does.
+  collide::Schedule schedule;
+  schedule.build(contacts, bodies);
+  double seconds = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    schedule.build(contacts, bodies);
+    const auto t1 = Clock::now();
+    state.SetIterationTime(seconds_between(t0, t1));
+    seconds += seconds_between(t0, t1);
+  }
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.seconds = seconds;
+  columns.batches = static_cast<double>(schedule.batch_count());
+  columns.schedule_bytes_per_contact = static_cast<double>(schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+}
+
+template <class F>
+void add_row(const std::string& name, F&& f) {
+  benchmark::RegisterBenchmark(name.c_str(), std::forward<F>(f))->UseManualTime()->Unit(benchmark::kMicrosecond);
+}
+
+/// Registers one group: every row that shares the scene (kind, T, n).
+template <class T>
+void register_group(Kind kind, std::size_t n) {
+  const char* precision = precision_name<T>();
+  if (kind != Kind::pairs_mu) {
+    add_row(schedule_name(kind, precision, n), [=](benchmark::State& s) { schedule_row<T>(s, kind, n); });
+  }
+  for (Path path : {Path::scalar, Path::simd}) {
+    for (int threads : {1, 2}) {
+      add_row(solve_name(kind, precision, path, threads, n),
+              [=](benchmark::State& s) { solve_row<T>(s, kind, n, path, threads); });
+    }
+  }
+  add_row(textbook_name(kind, precision, n), [=](benchmark::State& s) { textbook_row<T>(s, kind, n); });
+}
+
+// ---------------------------------------------------------------------------
+// Start-up check: a benchmark of a wrong kernel measures nothing useful.
+// ---------------------------------------------------------------------------
+
+template <class T>
+bool check_scene(Kind kind, std::ostream& out) {
+  const std::size_t n = 5000;
+  const collide::Scene<T> original = generate<T>(kind, n);
+  auto run = [&](auto&& solve) {
+    collide::Scene<T> scene = original;
+    collide::ImpulseBuffer<T> impulses(n);
+    solve(scene, impulses);
+    return std::make_pair(std::move(scene), std::move(impulses));
+  };
+  auto with_solver = [&](Path path, int threads) {
+    return [=](collide::Scene<T>& scene, collide::ImpulseBuffer<T>& impulses) {
+      collide::SolverOptions options;
+      options.path = path;
+      options.threads = threads;
+      collide::solve(scene.bodies.view(), scene.contacts.view(), impulses.view(), options);
+    };
+  };
+  const auto scalar = run(with_solver(Path::scalar, 1));
+  const auto simd = run(with_solver(Path::simd, 2));
+  const auto textbook = run([](collide::Scene<T>& scene, collide::ImpulseBuffer<T>& impulses) {
+    textbook_solve(scene.bodies.view(), scene.contacts.view(), impulses.view());
+  });
+
+  // Flattens v, w and J of one result.
+  auto values = [](const auto& result) {
+    std::vector<T> out;
+    const collide::BodyView<const T> b = result.first.bodies.view();
+    for (const T* a : {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z}) out.insert(out.end(), a, a + b.count);
+    const collide::ImpulseView<const T> j = result.second.view();
+    for (const T* a : {j.j.x, j.j.y, j.j.z}) out.insert(out.end(), a, a + j.count);
+    return out;
+  };
+  const std::vector<T> vs = values(scalar), vv = values(simd), vt = values(textbook);
+  const bool bitwise = std::memcmp(vs.data(), vv.data(), vs.size() * sizeof(T)) == 0;
+  double max_diff = 0, max_value = 0;
+  for (std::size_t i = 0; i < vv.size(); ++i) {
+    max_diff = std::max(max_diff, std::abs(static_cast<double>(vv[i]) - static_cast<double>(vt[i])));
+    max_value = std::max(max_value, std::abs(static_cast<double>(vt[i])));
+  }
+  const double relative = max_value > 0 ? max_diff / max_value : max_diff;
+  // Rounding differences grow along the chains of shared bodies in debris,
+  // so the tolerance is loose; it catches a wrong law, not a wrong last bit.
+  const double tolerance = sizeof(T) == 4 ? 1e-2 : 1e-8;
+  const bool ok = bitwise && relative <= tolerance;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "check %-9s %s n=%zu: scalar/t:1 vs simd/t:2 %s; simd vs textbook max|diff|/max|x| = %.2e%s\n",
+                kind_name(kind), precision_name<T>(), n, bitwise ? "bitwise equal" : "DIFFER (kernel bug?)", relative,
+                relative <= tolerance ? "" : " (TOO LARGE: kernel or textbook bug?)");
+  out << line;
+  return ok;
+}
+
+// ---------------------------------------------------------------------------
+// Summary
+// ---------------------------------------------------------------------------
+
+struct Result {
+  double coll_per_s = 0, gbs = 0, bw_frac = 0;
+  bool valid = false;
+};
+
+/// Wraps the display reporter chosen by the flags and keeps each row's
+/// counters for the summary.
+class CollectingReporter : public benchmark::BenchmarkReporter {
+ public:
+  explicit CollectingReporter(benchmark::BenchmarkReporter* inner) : inner_(inner) {}
+  bool ReportContext(const Context& context) override { return inner_->ReportContext(context); }
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.error_occurred) continue;
+      // With repetitions, the median aggregate wins over single repetitions.
+      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+      if (run.run_type == Run::RT_Aggregate && !median) continue;
+      const std::string key = row_key(run);
+      Result& r = results_[key];
+      if (r.valid && !median && had_median_[key]) continue;
+      auto counter = [&](const char* name) {
+        const auto it = run.counters.find(name);
+        return it == run.counters.end() ? 0.0 : it->second.value;
+      };
+      r = Result{counter("coll/s"), counter("GB/s"), counter("bw_frac"), true};
+      if (median) had_median_[key] = true;
+    }
+    inner_->ReportRuns(runs);
+  }
+  void Finalize() override { inner_->Finalize(); }
+
+  // The name as registered: Google Benchmark appends "/manual_time".
+  static std::string row_key(const Run& run) {
+    std::string name = run.run_name.str();
+    const std::string suffix = "/manual_time";
+    if (name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      name.resize(name.size() - suffix.size());
+    }
+    return name;
+  }
+
+  [[nodiscard]] Result get(const std::string& name) const {
+    const auto it = results_.find(name);
+    return it == results_.end() ? Result{} : it->second;
+  }
+
+ private:
+  std::unique_ptr<benchmark::BenchmarkReporter> inner_;
+  std::map<std::string, Result> results_;
+  std::map<std::string, bool> had_median_;
+};
+
+struct Options {
+  std::vector<std::size_t> sizes{10000, 65536, 262144, 1048576, 4194304, 16777216};
+  bool quick = false;
+  bool console = true;  // summary to stdout (else stderr, to keep JSON/CSV clean)
+};
+
+void print_summary(const CollectingReporter& rep, const Options& options, bool checks_ok, std::ostream& out) {
+  char line[512];
+  auto print = [&](const char* format, auto... args) {
+    std::snprintf(line, sizeof line, format, args...);
+    out << line;
+  };
+  const auto f32 = "f32";
+  const std::size_t cache_n = 65536, stream_n = 4194304;
+
+  print("\n==== collide_bench summary (one run) ====\n");
+  print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
+        std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20) >> 20);
+  print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
+  if (!checks_ok) print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
+
+  print("\nTargets                                                   measured   target  \n");
+  auto target = [&](const char* what, double value, double goal, const char* unit) {
+    if (!(value > 0)) {
+      print("  %-55s %9s  >= %4.2f%s  (rows not run)\n", what, "n/a", goal, unit);
+      return;
+    }
+    print("  %-55s %8.2f%s  >= %4.2f%s  %s\n", what, value, unit, goal, unit, value >= goal ? "MET" : "MISSED");
+  };
+  {
+    const Result r = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, stream_n));
+    target("pairs f32 simd t:2 n:4Mi, fraction of bandwidth bound", r.bw_frac, 0.60, "");
+  }
+  {
+    const Result simd = rep.get(solve_name(Kind::pairs, f32, Path::simd, 1, cache_n));
+    const Result scalar = rep.get(solve_name(Kind::pairs, f32, Path::scalar, 1, cache_n));
+    target("pairs f32 t:1 n:64Ki, simd / scalar", simd.valid && scalar.valid ? simd.coll_per_s / scalar.coll_per_s : 0,
+           5.0, "x");
+  }
+  {
+    const Result t2 = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, cache_n));
+    const Result t1 = rep.get(solve_name(Kind::pairs, f32, Path::simd, 1, cache_n));
+    target("pairs f32 simd n:64Ki (in LLC), 2 threads / 1 thread",
+           t1.valid && t2.valid ? t2.coll_per_s / t1.coll_per_s : 0, 1.8, "x");
+  }
+  {
+    const Result d = rep.get(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));
+    const Result p = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, stream_n));
+    target("f32 simd t:2 n:4Mi, debris / pairs throughput", d.valid && p.valid ? d.coll_per_s / p.coll_per_s : 0, 0.40,
+           "");
+  }
+
+  // The whole grid in one table: million collisions per second.
+  print("\nThroughput [Mcoll/s] (bw_frac of simd/t:2 = its GB/s over the 2-thread triad)\n");
+  print("  %-10s %-4s %9s  %9s %9s %9s %9s %9s  %7s\n", "scene", "prec", "N", "scalar/1", "scalar/2", "simd/1",
+        "simd/2", "textbook", "bw_frac");
+  std::vector<Kind> kinds{Kind::pairs, Kind::debris};
+  if (!options.quick) kinds.push_back(Kind::pairs_mu);
+  for (Kind kind : kinds) {
+    for (const char* precision : {"f32", "f64"}) {
+      for (std::size_t n : options.sizes) {
+        const Result rows[5] = {rep.get(solve_name(kind, precision, Path::scalar, 1, n)),
+                                rep.get(solve_name(kind, precision, Path::scalar, 2, n)),
+                                rep.get(solve_name(kind, precision, Path::simd, 1, n)),
+                                rep.get(solve_name(kind, precision, Path::simd, 2, n)),
+                                rep.get(textbook_name(kind, precision, n))};
+        if (std::none_of(rows, rows + 5, [](const Result& r) { return r.valid; })) continue;
+        print("  %-10s %-4s %9zu ", kind_name(kind), precision, n);
+        for (const Result& r : rows) {
+          if (r.valid) {
+            print(" %9.1f", r.coll_per_s / 1e6);
+          } else {
+            print(" %9s", "-");
+          }
+        }
+        if (rows[3].valid) {
+          print("  %7.2f\n", rows[3].bw_frac);
+        } else {
+          print("  %7s\n", "-");
+        }
+      }
+    }
+  }
+
+  print("\nMemory (schedule budget: 16 B/contact + 8 B/body beyond the caller's buffers)\n");
+  print("  %-26s %9s %9s %9s %10s %10s %9s %8s\n", "scene", "peak_MiB", "buf_MiB", "bench_MiB", "sched_B/c",
+        "sched/bud", "extra_MiB", "xtra/bud");
+  for (const MemoryRecord& m : g_memory) {
+    const double budget = 16.0 * static_cast<double>(m.contacts) + 8.0 * static_cast<double>(m.bodies);
+    const double mib = 1024.0 * 1024.0;
+    print("  %-26s %9.0f %9.0f %9.0f %10.2f %10.2f %9.1f %8.2f%s\n", m.scene.c_str(), m.peak_rss_bytes / mib,
+          m.buffer_bytes / mib, m.bench_bytes / mib, m.schedule_bytes / static_cast<double>(m.contacts),
+          m.schedule_bytes / budget, m.extra_bytes / mib, m.extra_bytes / budget,
+          m.peak_was_reset ? "" : " (peak not resettable)");
+  }
+  print(
+      "  peak = VmHWM after generating, building the schedule and one simd/t:2 solve; buf = bodies + contacts +\n"
+      "  impulses; bench = saved velocities and the cache-evict buffer; extra = peak growth over building the\n"
+      "  schedule and one solve, i.e. what the kernel costs beyond the caller's buffers.\n");
+}
+
+Options parse_own_flags(int& argc, char** argv) {
+  Options options;
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--quick") {
+      options.quick = true;
+      options.sizes = {65536, 4194304};
+    } else if (arg.rfind("--sizes=", 0) == 0) {
+      options.sizes.clear();
+      std::stringstream list(arg.substr(8));
+      std::string item;
+      while (std::getline(list, item, ',')) {
+        if (!item.empty()) options.sizes.push_back(static_cast<std::size_t>(std::stod(item)));
+      }
+    } else {
+      if (arg.rfind("--benchmark_format=", 0) == 0 && arg != "--benchmark_format=console") options.console = false;
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  return options;
+}
+
+}  // namespace
+}  // namespace collide_bench
+
+int main(int argc, char** argv) {
+  using namespace collide_bench;
+  Options options = parse_own_flags(argc, argv);
+
+  // Tabular counters by default: one aligned column per counter.
+  std::vector<char*> args(argv, argv + argc);
+  bool tabular_given = false, listing = false;
+  for (char* a : args) {
+    tabular_given |= std::strncmp(a, "--benchmark_counters_tabular", 28) == 0;
+    listing |= std::strcmp(a, "--benchmark_list_tests") == 0 || std::strcmp(a, "--benchmark_list_tests=true") == 0;
+  }
+  std::string tabular = "--benchmark_counters_tabular=true";
+  if (!tabular_given) args.push_back(tabular.data());
+  int args_count = static_cast<int>(args.size());
+  args.push_back(nullptr);
+  benchmark::Initialize(&args_count, args.data());
+  if (benchmark::ReportUnrecognizedArguments(args_count, args.data())) return 1;
+
+  std::ostream& info = options.console ? std::cout : std::cerr;
+  bool checks_ok = true;
+  // Listing the rows needs no check. (Looked up before Initialize, which
+  // removes the flags it knows from argv.)
+  if (!listing) {
+    for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu}) {
+      checks_ok &= check_scene<float>(kind, info);
+      checks_ok &= check_scene<double>(kind, info);
+    }
+  }
+
+  // The cache-evict buffer is resident from the start, so that every scene's
+  // memory figures include it alike (the summary lists it).
+  evict_caches();
+  register_triad();
+  const std::vector<std::size_t> mu_sizes{65536, 4194304};
+  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu}) {
+    if (kind == Kind::pairs_mu && options.quick) continue;
+    for (int precision : {4, 8}) {
+      if (precision == 8 && options.quick) continue;
+      for (std::size_t n : options.sizes) {
+        if (kind == Kind::pairs_mu && std::find(mu_sizes.begin(), mu_sizes.end(), n) == mu_sizes.end()) continue;
+        if (precision == 4) {
+          register_group<float>(kind, n);
+        } else {
+          register_group<double>(kind, n);
+        }
+      }
+    }
+  }
+
+  std::string spec = benchmark::GetBenchmarkFilter();
+  if (!spec.empty() && spec != "." && spec != "all" && spec[0] != '-') spec = "(" + spec + ")|^triad/";
+  CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
+  benchmark::RunSpecifiedBenchmarks(&reporter, spec);
+  print_summary(reporter, options, checks_ok, info);
+  benchmark::Shutdown();
+  return 0;
+}

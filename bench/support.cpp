@@ -1,0 +1,123 @@
+// bench/support.cpp - machine facts and counters shared by the benchmarks.
+//
+// Memory figures come from /proc/self/status, the kernel's own account of the
+// process, rather than from an allocator hook: the requirement is on peak
+// resident memory, and that includes what TBB, the C++ runtime and page
+// granularity add.
+#include "support.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+namespace collide_bench {
+
+namespace {
+
+// "32768K" / "2M" / "1048576" -> bytes; 0 if unparsable.
+std::size_t parse_size(const std::string& text) {
+  std::size_t pos = 0;
+  unsigned long long value = 0;
+  try {
+    value = std::stoull(text, &pos);
+  } catch (...) {
+    return 0;
+  }
+  const char unit = pos < text.size() ? text[pos] : ' ';
+  if (unit == 'K' || unit == 'k') value <<= 10;
+  if (unit == 'M' || unit == 'm') value <<= 20;
+  if (unit == 'G' || unit == 'g') value <<= 30;
+  return static_cast<std::size_t>(value);
+}
+
+double g_triad[3] = {0, 0, 0};
+
+}  // namespace
+
+std::size_t llc_bytes() {
+  static const std::size_t cached = [] {
+    // The highest-level unified or data cache of cpu0.
+    std::size_t best_level = 0, best_size = 0;
+    for (int index = 0; index < 8; ++index) {
+      const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/";
+      std::ifstream level_file(dir + "level"), type_file(dir + "type"), size_file(dir + "size");
+      std::size_t level = 0;
+      std::string type, size;
+      if (!(level_file >> level) || !(type_file >> type) || !(size_file >> size)) continue;
+      if (type == "Instruction") continue;
+      if (level > best_level) {
+        best_level = level;
+        best_size = parse_size(size);
+      }
+    }
+    return best_size ? best_size : std::size_t{32} << 20;
+  }();
+  return cached;
+}
+
+double status_bytes(const char* field) {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  const std::string key = std::string(field) + ":";
+  while (std::getline(status, line)) {
+    if (line.compare(0, key.size(), key) != 0) continue;
+    std::istringstream rest(line.substr(key.size()));
+    double kib = 0;
+    rest >> kib;
+    return kib * 1024.0;
+  }
+  return 0;
+}
+
+bool reset_peak_rss() {
+  std::ofstream clear_refs("/proc/self/clear_refs");
+  clear_refs << "5";
+  clear_refs.flush();
+  return static_cast<bool>(clear_refs);
+}
+
+void evict_caches() {
+  // Allocated once and kept: 4x the LLC is enough for any replacement policy
+  // to have dropped every earlier line, and reading it costs a few ms, which
+  // is not timed.
+  static const std::size_t size = evict_buffer_bytes();
+  static const std::unique_ptr<std::uint8_t[]> buffer = [] {
+    std::unique_ptr<std::uint8_t[]> b(new std::uint8_t[size]);
+    std::fill_n(b.get(), size, std::uint8_t{1});
+    return b;
+  }();
+  std::uint64_t sum = 0;
+  for (std::size_t i = 0; i < size; i += 64) sum += buffer[i];
+  benchmark::DoNotOptimize(sum);
+}
+
+std::size_t evict_buffer_bytes() { return 4 * llc_bytes(); }
+
+double triad_gbs(int threads) { return threads >= 1 && threads <= 2 ? g_triad[threads] : 0.0; }
+
+void set_triad_gbs(int threads, double gbs) {
+  if (threads >= 1 && threads <= 2) g_triad[threads] = gbs;
+}
+
+void set_counters(benchmark::State& state, const Columns& c) {
+  using benchmark::Counter;
+  const double iterations = static_cast<double>(state.iterations());
+  const double seconds = c.seconds > 0 ? c.seconds : 1e-300;
+  const double gbs = c.items * c.bytes_per_item * iterations / seconds / 1e9;
+  const double bound = triad_gbs(c.threads);
+  // Rates are computed here from the time the benchmark measured itself (the
+  // manual time that Google Benchmark also reports), so that the file
+  // reporter, which gets the same counters, agrees with the console.
+  state.counters["coll/s"] = Counter(c.items * iterations / seconds);
+  state.counters["GB/s"] = Counter(gbs);
+  state.counters["bw_frac"] = Counter(bound > 0 && c.bytes_per_item > 0 ? gbs / bound : 0.0);
+  state.counters["B/coll"] = Counter(c.bytes_per_item);
+  state.counters["batches"] = Counter(c.batches);
+  state.counters["sched_B/c"] = Counter(c.schedule_bytes_per_contact);
+  state.counters["peak_MiB"] = Counter(status_bytes("VmHWM") / (1024.0 * 1024.0));
+}
+
+}  // namespace collide_bench

@@ -1,0 +1,90 @@
+// bench/support.hpp - what every benchmark of collide_bench shares: the
+// byte count of the law, the machine's cache and memory facts, the triad
+// bandwidth measured earlier in the same run, and the counter layout.
+//
+// Design notes
+// ------------
+// * Bytes per collision is a property of the model, not of the code: the law's
+//   inputs and outputs, each counted once, per contact. For the rigid model a
+//   contact reads, for each of its two bodies, the inverse mass, the three
+//   inverse moments, the quaternion, the position, v and w (17 values) and
+//   writes v and w (6 values); it reads its two 4-byte indices, c, n and e (7
+//   values, 8 with mu) and writes J (3 values). In float that is
+//   2 * 23 * 4 + 2 * 4 + 7 * 4 + 3 * 4 = 232 bytes. A kernel that streams
+//   those bytes at the triad's rate is at 100% of the bandwidth bound; a
+//   debris scene, whose bodies are shared, may beat 100% because the same body
+//   is counted once per contact but fetched from cache the second time.
+// * The triad benchmarks run first and publish their bandwidth here, so every
+//   later row can report its fraction of the bound measured on the same
+//   machine, in the same process, a few seconds earlier.
+// * Every row of the table has the same counters (see Columns), so the
+//   tabular console output prints one header for the whole run; a column that
+//   does not apply to a row is 0.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+
+#include "collide/contacts.hpp"
+
+namespace collide_bench {
+
+using Clock = std::chrono::steady_clock;
+
+inline double seconds_between(Clock::time_point t0, Clock::time_point t1) {
+  return std::chrono::duration<double>(t1 - t0).count();
+}
+
+/// Bytes of the rigid law's inputs and outputs for one contact, each counted
+/// once (232 for float without friction, 456 for double).
+template <class T>
+constexpr std::size_t bytes_per_collision(bool friction) {
+  constexpr std::size_t body_values = 1 + 3 + 4 + 3 + 3 + 3 /* read */ + 6 /* write v, w */;
+  const std::size_t contact_values = 3 + 3 + 1 + (friction ? 1 : 0) /* read c, n, e, mu */ + 3 /* write J */;
+  return 2 * body_values * sizeof(T) + 2 * sizeof(collide::BodyIndex) + contact_values * sizeof(T);
+}
+
+/// Size of the last-level cache in bytes, from sysfs (the hypervisor's cpuid,
+/// which sysconf reads, may report the whole host's L3). 32 MiB if unknown.
+std::size_t llc_bytes();
+
+/// A field of /proc/self/status ("VmRSS", "VmHWM") in bytes, or 0 if unknown.
+double status_bytes(const char* field);
+
+/// Resets the peak resident set size (VmHWM) to the current RSS by writing 5
+/// to /proc/self/clear_refs. Returns false where the kernel does not allow it.
+bool reset_peak_rss();
+
+/// Streams a buffer of four times the last-level cache through the caches so
+/// that none of a scene's lines is left in them, dirty lines included (their
+/// write-back happens here rather than inside the next timed solve).
+void evict_caches();
+/// Bytes of the buffer evict_caches() streams (resident once it first ran).
+std::size_t evict_buffer_bytes();
+
+/// Triad bandwidth [GB/s] measured by the triad/t:1 and triad/t:2 rows of this
+/// run, 0 until they ran. Index: thread count.
+double triad_gbs(int threads);
+void set_triad_gbs(int threads, double gbs);
+
+/// Registers triad/t:1 and triad/t:2. Must come before every other row.
+void register_triad();
+
+/// The counters of every row (see the design notes above).
+struct Columns {
+  double items = 0;           ///< per iteration: collisions, contacts scheduled, triad elements
+  double bytes_per_item = 0;  ///< law bytes per collision (12 for the triad)
+  double seconds = 0;         ///< measured time of all iterations together
+  int threads = 1;            ///< for the bandwidth bound
+  double batches = 0;         ///< schedule batches
+  double schedule_bytes_per_contact = 0;
+};
+
+/// Writes the common counters: coll/s, GB/s, bw_frac, B/coll, batches,
+/// sched_B/c, peak_MiB.
+void set_counters(benchmark::State& state, const Columns& columns);
+
+}  // namespace collide_bench
