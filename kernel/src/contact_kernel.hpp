@@ -1,6 +1,7 @@
 // contact_kernel.hpp - the collision law for W contacts at once, written once
-// over a lane type and instantiated for the scalar path (W = 1) and the SIMD
-// path (W = 8 float / 4 double with AVX2).
+// over a lane type and a body model, and instantiated for the scalar path
+// (W = 1), the SIMD path (W = 8 float / 4 double with AVX2) and the three
+// body models (particle, sphere, rigid; see collide/model.hpp).
 //
 // Derivation (docs/collision-law.md has the full statement)
 // ----------------------------------------------------------
@@ -35,34 +36,51 @@
 // a caller's stale inverse moments cannot move them, and they are never
 // written (see the driver in solve.cpp).
 //
+// Body models. The rigid model is the derivation above. The sphere model has
+// Iw^-1 = s I, so h = r x d stays in the world frame and no rotation is
+// formed; the particle model has no rotational term at all (and reads
+// neither p nor w nor the contact point). Each model's terms are selected
+// with `if constexpr` inside the one kernel body below, so the operations
+// they share happen in the same order in all three.
+//
 // Precision: cancellation happens only in u (the velocity terms may be large
 // and nearly opposite). The error of jn is bounded by a few eps times
 // (1 + e) * (|va| + |wa||ra| + |vb| + |wb||rb|) / K(n), the "impulse scale"
 // that reference.hpp computes and the tests and the report measure against.
 #pragma once
 
+#include <type_traits>
+
 #include "lanes.hpp"
 
 namespace collide::detail {
 
+struct ParticleModel {};
+struct SphereModel {};
+struct RigidModel {};
+
+template <class M>
+inline constexpr bool kRotates = !std::is_same_v<M, ParticleModel>;
+
 /// The state of the W bodies on one side of W contacts, gathered into lanes.
-template <class V>
+/// Fields a model does not use are left unset and never read.
+template <class M, class V>
 struct BodyLanes {
-  V inv_mass;          // [1/kg], 0 = immovable
-  Vec3<V> inv_inertia; // body frame [1/(kg m^2)]
-  Mat3<V> rotation;    // body to world
-  Vec3<V> p;           // [m]
-  Vec3<V> v;           // [m/s]
-  Vec3<V> w;           // [rad/s]
+  V inv_mass;           // [1/kg], 0 = immovable
+  Vec3<V> inv_inertia;  // rigid: body frame [1/(kg m^2)]; sphere: x only
+  Mat3<V> rotation;     // rigid: body to world
+  Vec3<V> p;            // [m] (sphere, rigid)
+  Vec3<V> v;            // [m/s]
+  Vec3<V> w;            // [rad/s] (sphere, rigid)
 };
 
 /// The W contacts, gathered into lanes.
 template <class V>
 struct ContactLanes {
-  Vec3<V> c;  // [m]
+  Vec3<V> c;  // [m] (sphere, rigid)
   Vec3<V> n;  // unit, from b towards a
   V e;
-  V mu;       // read only when the kernel runs with friction
+  V mu;  // read only when the kernel runs with friction
 };
 
 /// What the kernel leaves in lanes, beyond the updated body velocities.
@@ -72,62 +90,101 @@ struct ContactResult {
 };
 
 /// Immovable bodies have no rotational response either, whatever they store.
-template <class V>
-COLLIDE_LANE_INLINE void zero_immovable_inertia(BodyLanes<V>& body) {
+template <class M, class V>
+COLLIDE_LANE_INLINE void zero_immovable_inertia(BodyLanes<M, V>& body) {
   const auto immovable = body.inv_mass == V(0);
-  stdx::where(immovable, body.inv_inertia.x) = V(0);
-  stdx::where(immovable, body.inv_inertia.y) = V(0);
-  stdx::where(immovable, body.inv_inertia.z) = V(0);
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    stdx::where(immovable, body.inv_inertia.x) = V(0);
+    stdx::where(immovable, body.inv_inertia.y) = V(0);
+    stdx::where(immovable, body.inv_inertia.z) = V(0);
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    stdx::where(immovable, body.inv_inertia.x) = V(0);
+  }
 }
 
 /// Relative velocity of a's contact point with respect to b's.
-template <class V>
-COLLIDE_LANE_INLINE Vec3<V> relative_velocity(const BodyLanes<V>& a, const BodyLanes<V>& b, const Vec3<V>& ra,
-                                 const Vec3<V>& rb) {
-  return (a.v + cross(a.w, ra)) - (b.v + cross(b.w, rb));
+template <class M, class V>
+COLLIDE_LANE_INLINE Vec3<V> relative_velocity(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b, const Vec3<V>& ra,
+                                              const Vec3<V>& rb) {
+  if constexpr (kRotates<M>) {
+    return (a.v + cross(a.w, ra)) - (b.v + cross(b.w, rb));
+  } else {
+    return a.v - b.v;
+  }
 }
 
-/// One body's rotational share of K(d), and invI * h for applying the impulse.
+/// One body's rotational share of K(d), and the angular response per unit
+/// impulse: invI * R^T (r x d) in the body frame (rigid), or
+/// invI (r x d) in the world frame (sphere). Particles have neither.
 template <class V>
 struct LeverArm {
-  Vec3<V> response;  // invI * R^T (r x d), body frame
-  V k;               // h . (invI * h)
+  Vec3<V> response;
+  V k;
 };
 
-template <class V>
-COLLIDE_LANE_INLINE LeverArm<V> lever_arm(const BodyLanes<V>& body, const Vec3<V>& r, const Vec3<V>& d) {
-  const Vec3<V> h = to_body(body.rotation, cross(r, d));
-  const Vec3<V> response = hadamard(body.inv_inertia, h);
-  return {response, dot(h, response)};
+template <class M, class V>
+COLLIDE_LANE_INLINE LeverArm<V> lever_arm(const BodyLanes<M, V>& body, const Vec3<V>& r, const Vec3<V>& d) {
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    const Vec3<V> h = to_body(body.rotation, cross(r, d));
+    const Vec3<V> response = hadamard(body.inv_inertia, h);
+    return {response, dot(h, response)};
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    const Vec3<V> h = cross(r, d);
+    const Vec3<V> response = h * body.inv_inertia.x;
+    return {response, dot(h, response)};
+  } else {
+    return {};
+  }
+}
+
+/// K(d) in the law's order: 1/ma + 1/mb + a's term + b's term.
+template <class M, class V>
+COLLIDE_LANE_INLINE V inverse_effective_mass(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                             const LeverArm<V>& arm_a, const LeverArm<V>& arm_b) {
+  if constexpr (kRotates<M>) {
+    return ((a.inv_mass + b.inv_mass) + arm_a.k) + arm_b.k;
+  } else {
+    return a.inv_mass + b.inv_mass;
+  }
 }
 
 /// Applies the impulse s * d to a (and -s * d to b) where `active`, given the
 /// lever arms of d. Inactive lanes keep their velocities bit for bit.
-template <class V>
-COLLIDE_LANE_INLINE void apply_impulse(BodyLanes<V>& a, BodyLanes<V>& b, const Vec3<V>& d, const V& s, const LeverArm<V>& arm_a,
-                          const LeverArm<V>& arm_b, const typename V::mask_type& active) {
+template <class M, class V>
+COLLIDE_LANE_INLINE void apply_impulse(BodyLanes<M, V>& a, BodyLanes<M, V>& b, const Vec3<V>& d, const V& s,
+                                       const LeverArm<V>& arm_a, const LeverArm<V>& arm_b,
+                                       const typename V::mask_type& active) {
   const Vec3<V> p = d * s;
   a.v = select(active, a.v + p * a.inv_mass, a.v);
   b.v = select(active, b.v - p * b.inv_mass, b.v);
-  a.w = select(active, a.w + to_world(a.rotation, arm_a.response * s), a.w);
-  b.w = select(active, b.w - to_world(b.rotation, arm_b.response * s), b.w);
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    a.w = select(active, a.w + to_world(a.rotation, arm_a.response * s), a.w);
+    b.w = select(active, b.w - to_world(b.rotation, arm_b.response * s), b.w);
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    a.w = select(active, a.w + arm_a.response * s, a.w);
+    b.w = select(active, b.w - arm_b.response * s, b.w);
+  }
 }
 
 /// The law for W contacts whose bodies are pairwise distinct (or immovable).
 /// kFriction selects the Coulomb step; without it `mu` is never read.
-template <class V, bool kFriction>
-COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<V>& a, BodyLanes<V>& b, const ContactLanes<V>& contact) {
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                      const ContactLanes<V>& contact) {
   zero_immovable_inertia(a);
   zero_immovable_inertia(b);
   const Vec3<V>& n = contact.n;
-  const Vec3<V> ra = contact.c - a.p;
-  const Vec3<V> rb = contact.c - b.p;
+  Vec3<V> ra{};
+  Vec3<V> rb{};
+  if constexpr (kRotates<M>) {
+    ra = contact.c - a.p;
+    rb = contact.c - b.p;
+  }
 
   const V vn = dot(relative_velocity(a, b, ra, rb), n);
   const LeverArm<V> arm_a = lever_arm(a, ra, n);
   const LeverArm<V> arm_b = lever_arm(b, rb, n);
-  // K(n) in the law's order: 1/ma + 1/mb + a's term + b's term.
-  const V k_n = ((a.inv_mass + b.inv_mass) + arm_a.k) + arm_b.k;
+  const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
 
   const auto approaching = (vn < V(0)) && (k_n > V(0));
   // Inactive lanes may divide by zero here; their result is discarded.
@@ -146,7 +203,7 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<V>& a, BodyLanes
       const Vec3<V> t{ut.x / safe_len, ut.y / safe_len, ut.z / safe_len};
       const LeverArm<V> tarm_a = lever_arm(a, ra, t);
       const LeverArm<V> tarm_b = lever_arm(b, rb, t);
-      const V k_t = ((a.inv_mass + b.inv_mass) + tarm_a.k) + tarm_b.k;
+      const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
       const V jt = select(sliding, stdx::min(ut_len / k_t, contact.mu * jn), V(0));
       apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
       result.j = select(sliding, result.j - t * jt, result.j);

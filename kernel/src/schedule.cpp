@@ -13,21 +13,21 @@
 namespace collide {
 
 template <class T>
-void Schedule::build(const ContactView<T>& contacts, const BodyView<T>& bodies) {
+void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass) {
   const std::size_t n = contacts.count;
   contact_count_ = n;
-  body_count_ = bodies.count;
+  body_count_ = body_count;
   conflicts_ = 0;
   level_.resize(n);
-  body_next_.assign(bodies.count, 0);
+  body_next_.assign(body_count, 0);
 
   std::uint32_t levels = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const BodyIndex a = contacts.a[k];
     const BodyIndex b = contacts.b[k];
-    assert(a < bodies.count && b < bodies.count);
-    const bool movable_a = bodies.inv_mass[a] != T(0);
-    const bool movable_b = bodies.inv_mass[b] != T(0);
+    assert(a < body_count && b < body_count);
+    const bool movable_a = inv_mass[a] != T(0);
+    const bool movable_b = inv_mass[b] != T(0);
     const std::uint32_t after_a = movable_a ? body_next_[a] : 0;
     const std::uint32_t after_b = movable_b ? body_next_[b] : 0;
     conflicts_ += static_cast<std::size_t>(after_a > 0) + static_cast<std::size_t>(after_b > 0);
@@ -66,8 +66,8 @@ std::size_t Schedule::memory_bytes() const {
          contiguous_.capacity() * sizeof(std::uint8_t);
 }
 
-template void Schedule::build<float>(const ContactView<float>&, const BodyView<float>&);
-template void Schedule::build<double>(const ContactView<double>&, const BodyView<double>&);
-template void Schedule::build<long double>(const ContactView<long double>&, const BodyView<long double>&);
+template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*);
+template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*);
+template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*);
 
 }  // namespace collide

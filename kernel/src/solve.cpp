@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <type_traits>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -49,27 +50,77 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
-template <class V, class T>
-COLLIDE_LANE_INLINE void gather_body(const BodyView<T>& bodies, const BodyIndex* ids, BodyLanes<V>& out) {
-  out.inv_mass = gather<V>(bodies.inv_mass, ids);
-  out.inv_inertia = {gather<V>(bodies.inv_inertia.x, ids), gather<V>(bodies.inv_inertia.y, ids),
-                     gather<V>(bodies.inv_inertia.z, ids)};
-  out.rotation = rotation(gather<V>(bodies.q.w, ids), gather<V>(bodies.q.x, ids), gather<V>(bodies.q.y, ids),
-                          gather<V>(bodies.q.z, ids));
-  out.p = {gather<V>(bodies.p.x, ids), gather<V>(bodies.p.y, ids), gather<V>(bodies.p.z, ids)};
-  out.v = {gather<V>(bodies.v.x, ids), gather<V>(bodies.v.y, ids), gather<V>(bodies.v.z, ids)};
-  out.w = {gather<V>(bodies.w.x, ids), gather<V>(bodies.w.y, ids), gather<V>(bodies.w.z, ids)};
+/// The public view each model reads.
+template <class M, class T>
+struct ViewOf;
+template <class T>
+struct ViewOf<RigidModel, T> {
+  using type = BodyView<T>;
+};
+template <class T>
+struct ViewOf<SphereModel, T> {
+  using type = SphereView<T>;
+};
+template <class T>
+struct ViewOf<ParticleModel, T> {
+  using type = ParticleView<T>;
+};
+template <class M, class T>
+using ViewOfT = typename ViewOf<M, T>::type;
+
+/// The quaternion lanes of a rigid body, turned into its rotation once read.
+template <class V>
+struct QuatLanes {
+  V w, x, y, z;
+};
+
+/// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
+/// so that the index gather and the paired load share one field list.
+template <class M, class V, class T, class F>
+COLLIDE_LANE_INLINE void read_bodies(const ViewOfT<M, T>& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
+  f(view.inv_mass, a.inv_mass, b.inv_mass);
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
+    f(view.inv_inertia.y, a.inv_inertia.y, b.inv_inertia.y);
+    f(view.inv_inertia.z, a.inv_inertia.z, b.inv_inertia.z);
+    QuatLanes<V> qa;
+    QuatLanes<V> qb;
+    f(view.q.w, qa.w, qb.w);
+    f(view.q.x, qa.x, qb.x);
+    f(view.q.y, qa.y, qb.y);
+    f(view.q.z, qa.z, qb.z);
+    a.rotation = rotation(qa.w, qa.x, qa.y, qa.z);
+    b.rotation = rotation(qb.w, qb.x, qb.y, qb.z);
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
+  }
+  if constexpr (kRotates<M>) {
+    f(view.p.x, a.p.x, b.p.x);
+    f(view.p.y, a.p.y, b.p.y);
+    f(view.p.z, a.p.z, b.p.z);
+  }
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
 }
 
-template <class V, class T>
-COLLIDE_LANE_INLINE void scatter_body(const BodyLanes<V>& body, const BodyView<T>& bodies, const BodyIndex* ids) {
-  const auto movable = body.inv_mass != V(0);
-  scatter(body.v.x, bodies.v.x, ids, movable);
-  scatter(body.v.y, bodies.v.y, ids, movable);
-  scatter(body.v.z, bodies.v.z, ids, movable);
-  scatter(body.w.x, bodies.w.x, ids, movable);
-  scatter(body.w.y, bodies.w.y, ids, movable);
-  scatter(body.w.z, bodies.w.z, ids, movable);
+/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
+template <class M, class V, class T, class F>
+COLLIDE_LANE_INLINE void write_bodies(const ViewOfT<M, T>& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                      F&& f) {
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
 }
 
 /// The streaming-pairs layout: contact l of the group joins bodies
@@ -86,50 +137,10 @@ COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* 
   return paired;
 }
 
-template <class V, class T>
-COLLIDE_LANE_INLINE void load_pair_field(const T* field, BodyIndex first, V& a, V& b) {
-  load_deinterleaved<V>(field + first, a, b);
-}
-
-template <class V, class T>
-COLLIDE_LANE_INLINE void gather_paired(const BodyView<T>& bodies, BodyIndex first, BodyLanes<V>& a, BodyLanes<V>& b) {
-  load_pair_field(bodies.inv_mass, first, a.inv_mass, b.inv_mass);
-  load_pair_field(bodies.inv_inertia.x, first, a.inv_inertia.x, b.inv_inertia.x);
-  load_pair_field(bodies.inv_inertia.y, first, a.inv_inertia.y, b.inv_inertia.y);
-  load_pair_field(bodies.inv_inertia.z, first, a.inv_inertia.z, b.inv_inertia.z);
-  V qwa, qxa, qya, qza, qwb, qxb, qyb, qzb;
-  load_pair_field(bodies.q.w, first, qwa, qwb);
-  load_pair_field(bodies.q.x, first, qxa, qxb);
-  load_pair_field(bodies.q.y, first, qya, qyb);
-  load_pair_field(bodies.q.z, first, qza, qzb);
-  a.rotation = rotation(qwa, qxa, qya, qza);
-  b.rotation = rotation(qwb, qxb, qyb, qzb);
-  load_pair_field(bodies.p.x, first, a.p.x, b.p.x);
-  load_pair_field(bodies.p.y, first, a.p.y, b.p.y);
-  load_pair_field(bodies.p.z, first, a.p.z, b.p.z);
-  load_pair_field(bodies.v.x, first, a.v.x, b.v.x);
-  load_pair_field(bodies.v.y, first, a.v.y, b.v.y);
-  load_pair_field(bodies.v.z, first, a.v.z, b.v.z);
-  load_pair_field(bodies.w.x, first, a.w.x, b.w.x);
-  load_pair_field(bodies.w.y, first, a.w.y, b.w.y);
-  load_pair_field(bodies.w.z, first, a.w.z, b.w.z);
-}
-
-template <class V, class T>
-COLLIDE_LANE_INLINE void scatter_paired(const BodyLanes<V>& a, const BodyLanes<V>& b, const BodyView<T>& bodies,
-                                        BodyIndex first) {
-  store_interleaved(a.v.x, b.v.x, bodies.v.x + first);
-  store_interleaved(a.v.y, b.v.y, bodies.v.y + first);
-  store_interleaved(a.v.z, b.v.z, bodies.v.z + first);
-  store_interleaved(a.w.x, b.w.x, bodies.w.x + first);
-  store_interleaved(a.w.y, b.w.y, bodies.w.y + first);
-  store_interleaved(a.w.z, b.w.z, bodies.w.z + first);
-}
-
 /// Resolves one group of V::size() contacts.
-template <class V, bool kFriction, class T>
-COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                        const ContactGroup& g) {
+template <class M, class V, bool kFriction, class T>
+COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
+                                     const ImpulseView<T>& impulses, const ContactGroup& g) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
   BodyIndex ib[W];
@@ -142,30 +153,40 @@ COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactVie
   // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
   // would gain nothing. The arithmetic is the same either way.
   const bool paired = W > 1 && is_paired_layout<W>(ia, ib);
-  BodyLanes<V> a;
-  BodyLanes<V> b;
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
   if (paired) {
-    gather_paired(bodies, ia[0], a, b);
+    read_bodies<M, V, T>(bodies, a, b,
+                         [&](const T* field, V& la, V& lb) { load_deinterleaved(field + ia[0], la, lb); });
   } else {
-    gather_body(bodies, ia, a);
-    gather_body(bodies, ib, b);
+    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) {
+      la = gather<V>(field, ia);
+      lb = gather<V>(field, ib);
+    });
   }
 
   ContactLanes<V> c;
-  c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
   c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
   c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
   if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
 
-  const ContactResult<V> r = resolve_contacts<V, kFriction>(a, b, c);
+  const ContactResult<V> r = resolve_contacts<M, V, kFriction>(a, b, c);
 
   // An immovable body is never written, not even with its own value: another
   // thread may be reading it (the ground is in many contacts of a batch).
-  if (paired && stdx::all_of((a.inv_mass != V(0)) && (b.inv_mass != V(0)))) {
-    scatter_paired(a, b, bodies, ia[0]);
+  const auto movable_a = a.inv_mass != V(0);
+  const auto movable_b = b.inv_mass != V(0);
+  if (paired && stdx::all_of(movable_a && movable_b)) {
+    write_bodies<M, V, T>(bodies, a, b,
+                          [&](T* field, const V& la, const V& lb) { store_interleaved(la, lb, field + ia[0]); });
   } else {
-    scatter_body(a, bodies, ia);
-    scatter_body(b, bodies, ib);
+    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) {
+      scatter(la, field, ia, movable_a);
+      scatter(lb, field, ib, movable_b);
+    });
   }
   if (g.contiguous) {
     store(r.j.x, impulses.j.x + g.first);
@@ -180,28 +201,28 @@ COLLIDE_LANE_INLINE void solve_group(const BodyView<T>& bodies, const ContactVie
 }
 
 /// Contacts [begin, end) of the schedule's order, all inside one batch.
-template <class V, bool kFriction, class T>
-void solve_range(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+template <class M, class V, bool kFriction, class T>
+void solve_range(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                  const std::uint32_t* order, bool contiguous, std::size_t begin, std::size_t end) {
   using Tail = ScalarLanes<T>;
   constexpr std::size_t W = V::size();
   std::size_t i = begin;
   for (; i + W <= end; i += W) {
-    solve_group<V, kFriction>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
   }
   for (; i < end; ++i) {
-    solve_group<Tail, kFriction>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, Tail, kFriction, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
   }
 }
 
-template <class V, class T>
-void solve_range_any(bool friction, const BodyView<T>& bodies, const ContactView<T>& contacts,
+template <class M, class V, class T>
+void solve_range_any(bool friction, const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
                      const ImpulseView<T>& impulses, const std::uint32_t* order, bool contiguous, std::size_t begin,
                      std::size_t end) {
   if (friction) {
-    solve_range<V, true>(bodies, contacts, impulses, order, contiguous, begin, end);
+    solve_range<M, V, true, T>(bodies, contacts, impulses, order, contiguous, begin, end);
   } else {
-    solve_range<V, false>(bodies, contacts, impulses, order, contiguous, begin, end);
+    solve_range<M, V, false, T>(bodies, contacts, impulses, order, contiguous, begin, end);
   }
 }
 
@@ -212,8 +233,7 @@ struct Solver::Impl {
   SolverOptions options;
   tbb::task_arena arena;
 
-  explicit Impl(const SolverOptions& o)
-      : options(o), arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic) {}
+  explicit Impl(const SolverOptions& o) : options(o), arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic) {}
 };
 
 Solver::Solver(const SolverOptions& options) : impl_(std::make_unique<Impl>(options)) {
@@ -226,37 +246,49 @@ Solver& Solver::operator=(Solver&&) noexcept = default;
 
 const SolverOptions& Solver::options() const { return impl_->options; }
 
-template <class T>
-SolveStats Solver::solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                         const Schedule& schedule) const {
+namespace detail {
+namespace {
+
+template <class M>
+constexpr Model model_of() {
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    return Model::rigid;
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    return Model::sphere;
+  } else {
+    return Model::particle;
+  }
+}
+
+/// Walks the batches of the schedule; blocks of a large batch run in parallel.
+template <class M, class T>
+SolveStats run_schedule(const SolverOptions& opt, tbb::task_arena& arena, const ViewOfT<M, T>& bodies,
+                        const ContactView<T>& contacts, const ImpulseView<T>& impulses, const Schedule& schedule) {
   assert(schedule.contact_count() == contacts.count);
   assert(schedule.body_count() == bodies.count);
   assert(impulses.count == contacts.count);
 
-  const SolverOptions& opt = impl_->options;
   const bool friction = contacts.mu != nullptr;
   const bool simd = opt.path == Path::simd;
-  const std::size_t width = simd ? detail::SimdLanes<T>::size() : 1;
+  const std::size_t width = simd ? SimdLanes<T>::size() : 1;
   const std::size_t block = std::max<std::size_t>(width, (opt.block + width - 1) / width * width);
   const std::uint32_t* order = schedule.order();
 
   auto run = [&](bool contiguous, std::size_t begin, std::size_t end) {
     if (simd) {
-      detail::solve_range_any<detail::SimdLanes<T>>(friction, bodies, contacts, impulses, order, contiguous, begin,
-                                                    end);
+      solve_range_any<M, SimdLanes<T>, T>(friction, bodies, contacts, impulses, order, contiguous, begin, end);
     } else {
-      detail::solve_range_any<detail::ScalarLanes<T>>(friction, bodies, contacts, impulses, order, contiguous, begin,
-                                                      end);
+      solve_range_any<M, ScalarLanes<T>, T>(friction, bodies, contacts, impulses, order, contiguous, begin, end);
     }
   };
 
-  impl_->arena.execute([&] {
+  arena.execute([&] {
     for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
       const std::size_t begin = schedule.batch_begin(k);
       const std::size_t end = schedule.batch_begin(k + 1);
       const bool contiguous = schedule.batch_is_contiguous(k);
       const std::size_t n = end - begin;
-      if (n < 2 * block || impl_->arena.max_concurrency() == 1) {
+      if (n < 2 * block || arena.max_concurrency() == 1) {
         run(contiguous, begin, end);
         continue;
       }
@@ -276,10 +308,50 @@ SolveStats Solver::solve(const BodyView<T>& bodies, const ContactView<T>& contac
   stats.contacts = contacts.count;
   stats.batches = schedule.batch_count();
   stats.lanes = width;
-  stats.threads = impl_->arena.max_concurrency();
-  stats.model = Model::rigid;
+  stats.threads = arena.max_concurrency();
+  stats.model = model_of<M>();
   stats.path = opt.path;
+  stats.friction = friction;
   return stats;
+}
+
+}  // namespace
+}  // namespace detail
+
+template <class T>
+SolveStats Solver::solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                         const Schedule& schedule) const {
+  return detail::run_schedule<detail::RigidModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+                                                     schedule);
+}
+
+template <class T>
+SolveStats Solver::solve(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                         const Schedule& schedule) const {
+  return detail::run_schedule<detail::SphereModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+                                                      schedule);
+}
+
+template <class T>
+SolveStats Solver::solve(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                         const Schedule& schedule) const {
+  return detail::run_schedule<detail::ParticleModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+                                                        schedule);
+}
+
+template <class T>
+SolveStats Solver::solve(Model model, const BodyView<T>& bodies, const ContactView<T>& contacts,
+                         const ImpulseView<T>& impulses, const Schedule& schedule) const {
+  assert(model_misfit(model, bodies, contacts).empty());
+  switch (model) {
+    case Model::particle:
+      return solve(particle_view(bodies), contacts, impulses, schedule);
+    case Model::sphere:
+      return solve(sphere_view(bodies), contacts, impulses, schedule);
+    case Model::rigid:
+      break;
+  }
+  return solve(bodies, contacts, impulses, schedule);
 }
 
 template <class T>
@@ -287,7 +359,7 @@ SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, cons
                  const SolverOptions& options) {
   Schedule schedule;
   schedule.build(contacts, bodies);
-  return Solver(options).solve(bodies, contacts, impulses, schedule);
+  return Solver(options).solve(choose_model(bodies, contacts), bodies, contacts, impulses, schedule);
 }
 
 template <class T>
@@ -296,23 +368,21 @@ std::size_t simd_width() {
 }
 
 const char* to_string(Path path) { return path == Path::simd ? "simd" : "scalar"; }
-const char* to_string(Model model) {
-  switch (model) {
-    case Model::rigid:
-      return "rigid";
-  }
-  return "?";
-}
 
-template SolveStats Solver::solve<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&,
-                                         const Schedule&) const;
-template SolveStats Solver::solve<double>(const BodyView<double>&, const ContactView<double>&,
-                                          const ImpulseView<double>&, const Schedule&) const;
-template SolveStats solve<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&,
-                                 const SolverOptions&);
-template SolveStats solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&,
-                                  const SolverOptions&);
-template std::size_t simd_width<float>();
-template std::size_t simd_width<double>();
+#define COLLIDE_INSTANTIATE(T)                                                                                  \
+  template SolveStats Solver::solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
+                                       const Schedule&) const;                                                  \
+  template SolveStats Solver::solve<T>(const SphereView<T>&, const ContactView<T>&, const ImpulseView<T>&,      \
+                                       const Schedule&) const;                                                  \
+  template SolveStats Solver::solve<T>(const ParticleView<T>&, const ContactView<T>&, const ImpulseView<T>&,    \
+                                       const Schedule&) const;                                                  \
+  template SolveStats Solver::solve<T>(Model, const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&, \
+                                       const Schedule&) const;                                                  \
+  template SolveStats solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,                \
+                               const SolverOptions&);                                                           \
+  template std::size_t simd_width<T>();
+COLLIDE_INSTANTIATE(float)
+COLLIDE_INSTANTIATE(double)
+#undef COLLIDE_INSTANTIATE
 
 }  // namespace collide

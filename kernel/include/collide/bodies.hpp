@@ -61,16 +61,50 @@ struct BodyView {
   Vec3Array<T> w;
 };
 
+/// Non-owning view of `count` bodies of the sphere model: isotropic inertia,
+/// so no orientation is read. Same units as BodyView.
+template <class T>
+struct SphereView {
+  std::size_t count = 0;
+  T* inv_mass = nullptr;     ///< [1/kg], 0 = immovable
+  T* inv_inertia = nullptr;  ///< the one inverse moment [1/(kg m^2)]
+  Vec3Array<T> p;            ///< [m]
+  Vec3Array<T> v;            ///< [m/s], updated
+  Vec3Array<T> w;            ///< [rad/s], updated
+};
+
+/// Non-owning view of `count` bodies of the particle model: translation
+/// only. Neither position nor angular velocity is read or written.
+template <class T>
+struct ParticleView {
+  std::size_t count = 0;
+  T* inv_mass = nullptr;  ///< [1/kg], 0 = immovable
+  Vec3Array<T> v;         ///< [m/s], updated
+};
+
+/// The sphere-model view of rigid bodies (uses inv_inertia.x as the one
+/// moment; see choose_model() in model.hpp for when that is the law).
+template <class T>
+SphereView<T> sphere_view(const BodyView<T>& b) {
+  return {b.count, b.inv_mass, b.inv_inertia.x, b.p, b.v, b.w};
+}
+
+/// The particle-model view of rigid bodies.
+template <class T>
+ParticleView<T> particle_view(const BodyView<T>& b) {
+  return {b.count, b.inv_mass, b.v};
+}
+
 /// One body as a scene file describes it, in physical units. Convenience for
 /// building scenes; the kernels never see this type.
 template <class T>
 struct BodyRecord {
-  T m = 1;                 ///< mass [kg]; inf = immovable
-  T I[3] = {1, 1, 1};      ///< principal moments [kg m^2]; inf = no rotation about that axis
-  T q[4] = {1, 0, 0, 0};   ///< orientation (w, x, y, z), need not be normalised
-  T p[3] = {0, 0, 0};      ///< centre of mass [m]
-  T v[3] = {0, 0, 0};      ///< linear velocity [m/s]
-  T w[3] = {0, 0, 0};      ///< angular velocity [rad/s]
+  T m = 1;                ///< mass [kg]; inf = immovable
+  T I[3] = {1, 1, 1};     ///< principal moments [kg m^2]; inf = no rotation about that axis
+  T q[4] = {1, 0, 0, 0};  ///< orientation (w, x, y, z), need not be normalised
+  T p[3] = {0, 0, 0};     ///< centre of mass [m]
+  T v[3] = {0, 0, 0};     ///< linear velocity [m/s]
+  T w[3] = {0, 0, 0};     ///< angular velocity [rad/s]
 };
 
 /// Owning structure-of-arrays storage for bodies.

@@ -38,7 +38,12 @@ class Schedule {
   /// Builds the schedule. Bodies with inv_mass == 0 do not conflict.
   /// Precondition: every index is < bodies.count (see validate()).
   template <class T>
-  void build(const ContactView<T>& contacts, const BodyView<T>& bodies);
+  void build(const ContactView<T>& contacts, const BodyView<T>& bodies) {
+    build(contacts, bodies.count, bodies.inv_mass);
+  }
+  /// The same for any body model: only the inverse masses matter.
+  template <class T>
+  void build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass);
 
   /// Number of contacts the schedule was built for.
   [[nodiscard]] std::size_t contact_count() const { return contact_count_; }
@@ -68,15 +73,14 @@ class Schedule {
   std::size_t largest_batch_ = 0;
   std::size_t conflicts_ = 0;
   std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> level_;       // scratch: batch of each contact
-  std::vector<std::uint32_t> body_next_;   // scratch: first free batch of each body
+  std::vector<std::uint32_t> level_;      // scratch: batch of each contact
+  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body
   std::vector<std::uint32_t> batch_begin_;
   std::vector<std::uint8_t> contiguous_;
 };
 
-extern template void Schedule::build<float>(const ContactView<float>&, const BodyView<float>&);
-extern template void Schedule::build<double>(const ContactView<double>&, const BodyView<double>&);
-extern template void Schedule::build<long double>(const ContactView<long double>&,
-                                                  const BodyView<long double>&);
+extern template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*);
+extern template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*);
+extern template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*);
 
 }  // namespace collide

@@ -13,6 +13,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/model.hpp"
 #include "collide/schedule.hpp"
 
 namespace collide {
@@ -23,11 +24,7 @@ enum class Path {
   simd,    ///< SIMD lanes: 8 float / 4 double with AVX2, 4 / 2 with SSE2
 };
 
-/// The body model a kernel runs. Only the rigid model exists so far.
-enum class Model { rigid };
-
 const char* to_string(Path path);
-const char* to_string(Model model);
 
 struct SolverOptions {
   Path path = Path::simd;
@@ -46,6 +43,7 @@ struct SolveStats {
   int threads = 0;           ///< threads available to the solve
   Model model = Model::rigid;
   Path path = Path::simd;
+  bool friction = false;  ///< the Coulomb step ran (ContactView::mu was set)
 };
 
 /// Number of lanes of the SIMD path for T in this build.
@@ -72,13 +70,28 @@ class Solver {
   template <class T>
   SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                    const Schedule& schedule) const;
+  /// The sphere model (see model.hpp for when it is the law).
+  template <class T>
+  SolveStats solve(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+  /// The particle model (see model.hpp for when it is the law).
+  template <class T>
+  SolveStats solve(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+  /// Rigid bodies solved with `model`, which must fit them (model_misfit()
+  /// is empty; asserted in debug builds): the views of the smaller models
+  /// point into the same arrays, so nothing is copied.
+  template <class T>
+  SolveStats solve(Model model, const BodyView<T>& bodies, const ContactView<T>& contacts,
+                   const ImpulseView<T>& impulses, const Schedule& schedule) const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-/// One-shot convenience: builds a schedule and a solver and solves.
+/// One-shot convenience: builds a schedule and a solver and solves with the
+/// cheapest model that fits (choose_model()).
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                  const SolverOptions& options = {});
