@@ -23,13 +23,13 @@ using BodyIndex = std::uint32_t;
 template <class T>
 struct ContactView {
   std::size_t count = 0;
-  const BodyIndex* a = nullptr;    ///< body receiving +J
-  const BodyIndex* b = nullptr;    ///< body receiving -J
-  Vec3Array<const T> c;            ///< contact point, world frame [m]
-  Vec3Array<const T> n;            ///< unit normal from b towards a
-  const T* e = nullptr;            ///< restitution in [0, 1]; nullptr = uniform_e
-  T uniform_e = 1;                 ///< restitution when `e` is nullptr
-  const T* mu = nullptr;           ///< Coulomb friction >= 0; nullptr = frictionless
+  const BodyIndex* a = nullptr;  ///< body receiving +J
+  const BodyIndex* b = nullptr;  ///< body receiving -J
+  Vec3Array<const T> c;          ///< contact point, world frame [m]
+  Vec3Array<const T> n;          ///< unit normal from b towards a
+  const T* e = nullptr;          ///< restitution in [0, 1]; nullptr = uniform_e
+  T uniform_e = 1;               ///< restitution when `e` is nullptr
+  const T* mu = nullptr;         ///< Coulomb friction >= 0; nullptr = frictionless
 };
 
 /// Non-owning view of the impulse output: J, the total impulse on body a [N s].
@@ -98,7 +98,11 @@ class ImpulseBuffer {
  public:
   ImpulseBuffer() = default;
   explicit ImpulseBuffer(std::size_t n) { resize(n); }
-  void resize(std::size_t n) { x_.assign(n, T(0)); y_.assign(n, T(0)); z_.assign(n, T(0)); }
+  void resize(std::size_t n) {
+    x_.assign(n, T(0));
+    y_.assign(n, T(0));
+    z_.assign(n, T(0));
+  }
   [[nodiscard]] std::size_t size() const { return x_.size(); }
   [[nodiscard]] ImpulseView<T> view() { return {x_.size(), {x_.data(), y_.data(), z_.data()}}; }
   [[nodiscard]] ImpulseView<const T> view() const { return {x_.size(), {x_.data(), y_.data(), z_.data()}}; }

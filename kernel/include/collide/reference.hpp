@@ -19,11 +19,11 @@ namespace collide {
 /// Per-contact quantities of the reference solve, for error analysis.
 template <class S>
 struct ReferenceContact {
-  S vn = 0;           ///< approach speed u.n before the impulse [m/s] (< 0 approaching)
-  S k_n = 0;          ///< K(n), inverse effective mass along n [1/kg]
-  S k_t = 0;          ///< K(t) along the friction direction, 0 without friction [1/kg]
-  S jn = 0;           ///< normal impulse magnitude [N s]
-  S jt = 0;           ///< friction impulse magnitude [N s]
+  S vn = 0;   ///< approach speed u.n before the impulse [m/s] (< 0 approaching)
+  S k_n = 0;  ///< K(n), inverse effective mass along n [1/kg]
+  S k_t = 0;  ///< K(t) along the friction direction, 0 without friction [1/kg]
+  S jn = 0;   ///< normal impulse magnitude [N s]
+  S jt = 0;   ///< friction impulse magnitude [N s]
   /// Sum of the magnitudes of the terms of u: |va| + |wa||ra| + |vb| + |wb||rb|
   /// [m/s]. The relative velocity is a difference of these terms, so a kernel
   /// in precision eps cannot know u better than about eps * speed_scale.
