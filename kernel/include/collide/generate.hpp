@@ -39,4 +39,16 @@ Scene<T> generate_pairs(std::size_t pairs, const GenerateOptions& options = {});
 template <class T>
 Scene<T> generate_debris(std::size_t contacts, const GenerateOptions& options = {});
 
+// The pieces of the debris scene, each a pure function of its arguments, so
+// that `collide gen --debris` can stream the files in chunks.
+
+/// Number of bodies of the debris scene: the movable ones plus the ground.
+std::size_t debris_body_count(std::size_t contacts);
+/// Body i of the debris scene with `contacts` contacts; the last body
+/// (i == debris_body_count(contacts) - 1) is the immovable ground.
+void draw_debris_body(const GenerateOptions& options, std::size_t contacts, std::uint64_t i, BodyRecord<double>& body);
+/// Contact k of the debris scene, approaching in the initial state.
+void draw_debris_contact(const GenerateOptions& options, std::size_t contacts, std::uint64_t k,
+                         ContactRecord<double>& contact);
+
 }  // namespace collide

@@ -1,0 +1,53 @@
+// cli/commands.hpp - the subcommands of the `collide` tool and what they share.
+//
+// Design notes
+// ------------
+// * Exit codes are part of the interface (scripts and tests rely on them):
+//   0 success, 1 bad input or an I/O failure (nothing written), 2 usage
+//   error, 3 `solve --check` found an error above the documented bound.
+// * Options are GNU-style long options, "--name value" or "--name=value";
+//   an option given twice is a usage error rather than "last one wins", so
+//   a typo in a script cannot silently override an earlier value.
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace collide::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitCheckFailed = 3;
+
+/// A command line that does not follow the usage; the message says why.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One option a command accepts.
+struct OptionSpec {
+  const char* name;  ///< without the leading "--"
+  bool takes_value;
+};
+
+/// Parsed options: name -> value ("" for flags). "help" is set for --help/-h.
+using Options = std::map<std::string, std::string>;
+
+/// Parses argv[first..argc) against `specs`. Throws UsageError.
+Options parse_options(int argc, char** argv, int first, const std::vector<OptionSpec>& specs);
+/// The value of a required option. Throws UsageError when it is missing.
+const std::string& required(const Options& options, const std::string& name);
+/// Parses a non-negative decimal integer option value. Throws UsageError.
+unsigned long long parse_count(const std::string& name, const std::string& value);
+
+int run_solve(int argc, char** argv);
+int run_gen(int argc, char** argv);
+
+extern const char* const kSolveUsage;
+extern const char* const kGenUsage;
+
+}  // namespace collide::cli

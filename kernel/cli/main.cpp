@@ -1,0 +1,121 @@
+// cli/main.cpp - the `collide` command-line tool: dispatch and option parsing.
+//
+// Usage: collide <command> [options]; commands are `solve` and `gen`.
+// Every error is one line on stderr starting with "collide: ", and the exit
+// code says which kind (see commands.hpp).
+#include <charconv>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <string_view>
+
+#include "commands.hpp"
+
+namespace collide::cli {
+
+namespace {
+
+const char* const kMainUsage =
+    "usage: collide <command> [options]\n"
+    "\n"
+    "Batched rigid-body collision impulses (see docs/collision-law.md).\n"
+    "\n"
+    "commands:\n"
+    "  solve   resolve the contacts of a scene: read bodies.csv and contacts.csv,\n"
+    "          write the bodies with their new velocities and the impulses\n"
+    "  gen     write a random scene (pairs or debris) as bodies.csv and contacts.csv\n"
+    "\n"
+    "Run 'collide <command> --help' for the options of a command.\n"
+    "\n"
+    "exit codes: 0 success, 1 bad input or I/O error (nothing written),\n"
+    "            2 usage error, 3 solve --check found an error above the bound\n";
+
+}  // namespace
+
+Options parse_options(int argc, char** argv, int first, const std::vector<OptionSpec>& specs) {
+  Options options;
+  for (int i = first; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      options["help"] = "";
+      continue;
+    }
+    if (arg.substr(0, 2) != "--" || arg.size() == 2) {
+      throw UsageError("unexpected argument '" + std::string(arg) + "'");
+    }
+    const std::size_t eq = arg.find('=');
+    const std::string name(arg.substr(2, eq == std::string_view::npos ? std::string_view::npos : eq - 2));
+    const OptionSpec* spec = nullptr;
+    for (const OptionSpec& s : specs) {
+      if (name == s.name) spec = &s;
+    }
+    if (spec == nullptr) throw UsageError("unknown option '--" + name + "'");
+    if (options.count(name) != 0) throw UsageError("option '--" + name + "' given twice");
+    if (!spec->takes_value) {
+      if (eq != std::string_view::npos) throw UsageError("option '--" + name + "' takes no value");
+      options[name] = "";
+    } else if (eq != std::string_view::npos) {
+      options[name] = std::string(arg.substr(eq + 1));
+    } else {
+      // A following "--x" is another option, not this one's value.
+      if (i + 1 >= argc || std::strncmp(argv[i + 1], "--", 2) == 0) {
+        throw UsageError("option '--" + name + "' needs a value");
+      }
+      options[name] = argv[++i];
+    }
+    if (spec->takes_value && options[name].empty()) throw UsageError("option '--" + name + "' needs a value");
+  }
+  return options;
+}
+
+const std::string& required(const Options& options, const std::string& name) {
+  const auto it = options.find(name);
+  if (it == options.end()) throw UsageError("missing required option '--" + name + "'");
+  return it->second;
+}
+
+unsigned long long parse_count(const std::string& name, const std::string& value) {
+  unsigned long long n = 0;
+  const char* end = value.data() + value.size();
+  const auto [ptr, ec] = std::from_chars(value.data(), end, n);
+  if (value.empty() || ec != std::errc() || ptr != end) {
+    throw UsageError("option '--" + name + "' needs a non-negative integer, got '" + value + "'");
+  }
+  return n;
+}
+
+}  // namespace collide::cli
+
+int main(int argc, char** argv) {
+  using namespace collide::cli;
+  if (argc < 2) {
+    std::fputs(kMainUsage, stderr);
+    return kExitUsage;
+  }
+  const std::string_view command = argv[1];
+  if (command == "--help" || command == "-h" || command == "help") {
+    std::fputs(kMainUsage, stdout);
+    return kExitOk;
+  }
+  if (command == "--version") {
+    std::puts("collide 0.1.0");
+    return kExitOk;
+  }
+  try {
+    if (command == "solve") return run_solve(argc, argv);
+    if (command == "gen") return run_gen(argc, argv);
+    std::fprintf(stderr, "collide: unknown command '%s'\n\n%s", argv[1], kMainUsage);
+    return kExitUsage;
+  } catch (const UsageError& e) {
+    const char* usage = command == "solve" ? kSolveUsage : kGenUsage;
+    std::fprintf(stderr, "collide %s: %s\n\n%s", argv[1], e.what(), usage);
+    return kExitUsage;
+  } catch (const std::bad_alloc&) {
+    std::fputs("collide: out of memory\n", stderr);
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "collide: %s\n", e.what());
+    return kExitBadInput;
+  }
+}

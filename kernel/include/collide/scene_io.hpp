@@ -1,0 +1,187 @@
+// collide/scene_io.hpp - reading and writing the scene CSV files of the spec.
+//
+// Design notes
+// ------------
+// * Reading keeps two layers apart. `read_bodies` returns a BodyTable: the
+//   seventeen columns exactly as parsed, in the precision T the kernel runs
+//   in (inf kept for m and I, q not normalised). The solver needs inverse
+//   masses and unit quaternions (`to_body_buffer`), but the result file must
+//   copy every column other than v and w unchanged, so the writer takes the
+//   table and the solved velocities.
+// * Every bad input of the spec is a SceneError whose message names the file,
+//   the 1-based line, the 0-based data row (the body or contact id) and the
+//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got '-1'".
+//   The checks run on the parsed T values, so a value that is fine in double
+//   but unusable in float (1e39, a quaternion too small to normalise) is
+//   rejected with the precision named.
+// * The parse-from-memory entry points (`parse_bodies`, `parse_contacts`)
+//   take the text and a file name for the messages, so fuzzers and tests can
+//   drive the parser without files.
+// * Speed: the whole file is read into one buffer, split at line boundaries
+//   into chunks that are parsed in parallel (tbb) with std::from_chars; the
+//   first error in file order wins, so messages do not depend on threads.
+//   Writing formats blocks of rows in parallel with std::to_chars (shortest
+//   round trip: the text reads back to the same T) and writes them in order.
+// * Outputs go through OutputFile: a temporary file in the destination's
+//   directory, renamed over the destination by commit(). A failure, or an
+//   OutputFile destroyed without commit, leaves the destination untouched.
+//
+// The header is C++17, like the rest of the public API.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+
+namespace collide {
+
+/// Columns of bodies.csv, in file order.
+inline constexpr std::array<std::string_view, 17> kBodyColumns = {"m",  "Ix", "Iy", "Iz", "qw", "qx", "qy", "qz", "px",
+                                                                  "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz"};
+/// Columns of contacts.csv, in file order.
+inline constexpr std::array<std::string_view, 10> kContactColumns = {"a",  "b",  "cx", "cy", "cz",
+                                                                     "nx", "ny", "nz", "e",  "mu"};
+/// Columns of the impulses file.
+inline constexpr std::array<std::string_view, 3> kImpulseColumns = {"jx", "jy", "jz"};
+
+/// Allowed deviation of |n| from 1 before n is normalised.
+inline constexpr double kNormalTolerance = 1e-3;
+
+/// A scene file that cannot be read or written. For a bad value, line() is
+/// the 1-based line, row() the 0-based data row (body or contact id) and
+/// column() the column name; for a bad header row() is kNoRow; for an error
+/// about the whole file (cannot open, cannot write) line() is 0 and column()
+/// is empty.
+class SceneError : public std::runtime_error {
+ public:
+  static constexpr std::size_t kNoRow = static_cast<std::size_t>(-1);
+
+  SceneError(std::string file, std::size_t line, std::size_t row, std::string column, std::string reason);
+  /// An error about the whole file.
+  SceneError(std::string file, std::string reason);
+
+  [[nodiscard]] const std::string& file() const noexcept { return file_; }
+  [[nodiscard]] std::size_t line() const noexcept { return line_; }
+  [[nodiscard]] std::size_t row() const noexcept { return row_; }
+  [[nodiscard]] const std::string& column() const noexcept { return column_; }
+  [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
+
+ private:
+  std::string file_;
+  std::size_t line_ = 0;
+  std::size_t row_ = kNoRow;
+  std::string column_;
+  std::string reason_;
+};
+
+/// The columns of bodies.csv exactly as parsed: column[k][i] is column
+/// kBodyColumns[k] of body i. m and I may be inf; q is as written.
+template <class T>
+struct BodyTable {
+  enum Column : std::size_t { m, Ix, Iy, Iz, qw, qx, qy, qz, px, py, pz, vx, vy, vz, wx, wy, wz, kCount };
+  std::array<std::vector<T>, kCount> column;
+
+  [[nodiscard]] std::size_t size() const { return column[0].size(); }
+  void resize(std::size_t n) {
+    for (auto& c : column) c.resize(n);
+  }
+  /// Body i in physical units, as written in the file.
+  [[nodiscard]] BodyRecord<T> record(std::size_t i) const;
+  /// Appends a body in physical units (no checks).
+  void push_back(const BodyRecord<T>& body);
+};
+
+// ---------------------------------------------------------------------------
+// Reading. All readers throw SceneError on the first bad input in file order.
+// ---------------------------------------------------------------------------
+
+/// Parses the text of a bodies file. `file_name` only labels messages.
+template <class T>
+BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name);
+/// Reads and parses a bodies file.
+template <class T>
+BodyTable<T> read_bodies(const std::string& path);
+
+/// Converts a table into what the kernels consume (1/m, 1/I, unit q).
+template <class T>
+BodyBuffer<T> to_body_buffer(const BodyTable<T>& table);
+
+/// Parses the text of a contacts file whose ids refer to `body_count` bodies.
+/// |n| is checked against 1 within kNormalTolerance before n is normalised.
+template <class T>
+ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_name, std::size_t body_count);
+/// Reads and parses a contacts file.
+template <class T>
+ContactBuffer<T> read_contacts(const std::string& path, std::size_t body_count);
+
+/// Reads a whole file into memory (also used by the CLI to compare files).
+std::string read_file(const std::string& path);
+
+// ---------------------------------------------------------------------------
+// Writing.
+// ---------------------------------------------------------------------------
+
+/// A file written under a temporary name next to `path` and renamed onto
+/// `path` by commit(). Destroyed without commit, it removes the temporary
+/// and leaves `path` as it was. Not copyable; movable.
+class OutputFile {
+ public:
+  explicit OutputFile(std::string path);
+  ~OutputFile();
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  OutputFile(OutputFile&& other) noexcept;
+  OutputFile& operator=(OutputFile&& other) noexcept;
+
+  void write(std::string_view bytes);
+  /// Flushes, closes and renames the temporary onto the destination.
+  void commit();
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  void discard() noexcept;
+  std::string path_;
+  std::string temp_path_;
+  std::FILE* file_ = nullptr;
+};
+
+/// Writes the result bodies file: every column of `inputs` except v and w,
+/// which come from `solved` (same body count). Use std::as_const(buffer).view().
+template <class T>
+void write_bodies(OutputFile& out, const BodyTable<T>& inputs, const BodyView<const T>& solved);
+/// Writes the impulses file (header jx,jy,jz).
+template <class T>
+void write_impulses(OutputFile& out, const ImpulseView<const T>& impulses);
+/// Writes a body table as it is (a scene input file).
+template <class T>
+void write_body_table(OutputFile& out, const BodyTable<T>& table);
+
+/// In-memory forms of the writers above: the complete file text.
+template <class T>
+std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved);
+template <class T>
+std::string format_impulses(const ImpulseView<const T>& impulses);
+
+/// Header lines, newline included.
+std::string_view bodies_header();
+std::string_view contacts_header();
+std::string_view impulses_header();
+
+/// Appends one number in shortest round-trip form ("inf" for infinity).
+template <class T>
+void append_number(std::string& out, T value);
+/// Appends one bodies.csv row (newline included), values as given.
+template <class T>
+void append_body_row(std::string& out, const BodyRecord<T>& body);
+/// Appends one contacts.csv row (newline included), values as given.
+template <class T>
+void append_contact_row(std::string& out, const ContactRecord<T>& contact);
+
+}  // namespace collide

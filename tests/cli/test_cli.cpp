@@ -1,0 +1,633 @@
+// test_cli.cpp - the `collide` executable as a user sees it.
+//
+// Every test runs the real binary (COLLIDE_CLI_PATH) in its own directory
+// under the build tree and checks exit codes, messages and files:
+//   * every bad input of the spec: exit 1, a message naming the file, the row
+//     and the column, and no output file (a pre-existing one untouched);
+//   * gen: same seed, same bytes (whatever the thread count); other seed,
+//     other bytes;
+//   * gen + solve --check round trips, both precisions and both paths;
+//   * the written numbers read back to the values the library computes;
+//   * inf of immovable bodies and all unchanged columns survive a solve;
+//   * usage errors: exit 2.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collide/scene.hpp"
+#include "collide/scene_io.hpp"
+#include "collide/schedule.hpp"
+#include "collide/solve.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) {
+    if (c == '\'') {
+      q += "'\\''";
+    } else {
+      q += c;
+    }
+  }
+  return q + "'";
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void spit(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+const char* const kBodies =
+    "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
+    "2,0.8,0.8,0.8,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n"
+    "1.5,0.2,0.6,0.6,0.9238795325112867,0,0,0.3826834323650898,0.8,2.2,0,-0.5,-4,0,0,0,-2\n"
+    "4,2,1,2,1,0,0,0,-2,0.8,0,2,-1,0,0,1,0\n"
+    "inf,inf,inf,inf,1,0,0,0,0,-5,0,0,0,0,0,0,0\n";
+
+const char* const kContacts =
+    "a,b,cx,cy,cz,nx,ny,nz,e,mu\n"
+    "0,3,0,0,0,0,1,0,0.5,0.4\n"
+    "1,0,0.4,1.6,0,0,1,0,0.8,0\n"
+    "2,0,-1,0.9,0,-1,0,0,1,0.2\n"
+    "2,3,-2,0,0,0,1,0,0.3,0.6\n";
+
+/// Replaces line `line` (0 = header) of `text` with `replacement`.
+std::string replace_line(const std::string& text, std::size_t line, const std::string& replacement) {
+  std::istringstream in(text);
+  std::string out, l;
+  for (std::size_t i = 0; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
+  return out;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "." + info->name();
+    for (char& c : name) {
+      if (c == '/') c = '_';
+    }
+    dir_ = fs::path(COLLIDE_TEST_TMP) / name;
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+
+  fs::path path(const std::string& name) const { return dir_ / name; }
+
+  RunResult run(const std::vector<std::string>& args) const {
+    std::string cmd = shell_quote(COLLIDE_CLI_PATH);
+    for (const std::string& a : args) {
+      cmd += ' ';
+      cmd += shell_quote(a);
+    }
+    const fs::path out = dir_ / "_stdout.txt";
+    const fs::path err = dir_ / "_stderr.txt";
+    cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  /// Writes the scene files and runs solve on them with `extra` options.
+  RunResult solve(const std::string& bodies, const std::string& contacts, std::vector<std::string> extra = {}) const {
+    spit(path("bodies.csv"), bodies);
+    spit(path("contacts.csv"), contacts);
+    std::vector<std::string> args = {"solve",
+                                     "--bodies",
+                                     path("bodies.csv").string(),
+                                     "--contacts",
+                                     path("contacts.csv").string(),
+                                     "--out-bodies",
+                                     path("ob.csv").string(),
+                                     "--out-impulses",
+                                     path("oj.csv").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  }
+
+  /// Files in the test directory other than the inputs (outputs, temporaries).
+  std::vector<std::string> stray_files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      const std::string n = e.path().filename().string();
+      if (n != "bodies.csv" && n != "contacts.csv") names.push_back(n);
+    }
+    return names;
+  }
+
+  fs::path dir_;
+};
+
+// ---------------------------------------------------------------------------
+// Bad input: every case of the spec.
+// ---------------------------------------------------------------------------
+
+struct BadCase {
+  const char* name;
+  bool in_bodies;      // the defect is in bodies.csv (else contacts.csv)
+  std::size_t line;    // line to replace (0 = header)
+  const char* text;    // replacement line
+  const char* row;     // expected "row R" or "header"
+  const char* column;  // expected column name
+};
+
+const BadCase kBadCases[] = {
+    // bodies.csv
+    {"body_missing_column", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0", "row 1", "wz"},
+    {"body_extra_column", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2,7", "row 1", "wz"},
+    {"body_bad_header", true, 0, "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wq", "header", "wz"},
+    {"body_header_missing_column", true, 0, "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy", "header", "wz"},
+    {"body_header_extra_column", true, 0, "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz,extra", "header", "wz"},
+    {"body_not_a_number", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,1.2.3,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "px"},
+    {"body_empty_value", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,,-0.5,-4,0,0,0,-2", "row 1", "pz"},
+    {"body_nan", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,nan,0,0,0,-2", "row 1", "vy"},
+    {"body_nan_in_mass", true, 2, "NaN,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "m"},
+    {"body_inf_position", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,inf,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "px"},
+    {"body_inf_velocity", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,-Infinity,-2", "row 1", "wy"},
+    {"body_inf_quaternion", true, 2, "1.5,0.2,0.6,0.6,inf,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "qw"},
+    {"body_zero_mass", true, 2, "0,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "m"},
+    {"body_negative_mass", true, 2, "-1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "m"},
+    {"body_negative_inf_mass", true, 2, "-inf,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "m"},
+    {"body_zero_moment", true, 2, "1.5,0.2,0,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "Iy"},
+    {"body_negative_moment", true, 2, "1.5,0.2,0.6,-0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "Iz"},
+    {"body_zero_quaternion", true, 2, "1.5,0.2,0.6,0.6,0,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "qw"},
+    {"body_overflow", true, 2, "1.5,0.2,0.6,0.6,1,0,0,0,1e999,2.2,0,-0.5,-4,0,0,0,-2", "row 1", "px"},
+    {"body_empty_line", true, 2, "", "row 1", "m"},
+    // contacts.csv
+    {"contact_missing_column", false, 3, "2,0,-1,0.9,0,-1,0,0,1", "row 2", "mu"},
+    {"contact_extra_column", false, 3, "2,0,-1,0.9,0,-1,0,0,1,0.2,0", "row 2", "mu"},
+    {"contact_bad_header", false, 0, "a,b,cx,cy,cz,nx,ny,nz,mu,e", "header", "e"},
+    {"contact_not_a_number", false, 3, "2,0,-1,0.9,zero,-1,0,0,1,0.2", "row 2", "cz"},
+    {"contact_nan", false, 3, "2,0,-1,nan,0,-1,0,0,1,0.2", "row 2", "cy"},
+    {"contact_inf_point", false, 3, "2,0,inf,0.9,0,-1,0,0,1,0.2", "row 2", "cx"},
+    {"contact_inf_mu", false, 3, "2,0,-1,0.9,0,-1,0,0,1,inf", "row 2", "mu"},
+    {"contact_normal_too_long", false, 3, "2,0,-1,0.9,0,-1.01,0,0,1,0.2", "row 2", "nx"},
+    {"contact_normal_too_short", false, 3, "2,0,-1,0.9,0,0,0.99,0,1,0.2", "row 2", "nx"},
+    {"contact_normal_zero", false, 3, "2,0,-1,0.9,0,0,0,0,1,0.2", "row 2", "nx"},
+    {"contact_e_above_one", false, 3, "2,0,-1,0.9,0,-1,0,0,1.5,0.2", "row 2", "e"},
+    {"contact_e_negative", false, 3, "2,0,-1,0.9,0,-1,0,0,-0.1,0.2", "row 2", "e"},
+    {"contact_mu_negative", false, 3, "2,0,-1,0.9,0,-1,0,0,1,-0.2", "row 2", "mu"},
+    {"contact_a_out_of_range", false, 3, "4,0,-1,0.9,0,-1,0,0,1,0.2", "row 2", "a"},
+    {"contact_b_out_of_range", false, 3, "2,99,-1,0.9,0,-1,0,0,1,0.2", "row 2", "b"},
+    {"contact_b_negative", false, 3, "2,-1,-1,0.9,0,-1,0,0,1,0.2", "row 2", "b"},
+    {"contact_a_not_integer", false, 3, "1.5,0,-1,0.9,0,-1,0,0,1,0.2", "row 2", "a"},
+    {"contact_self", false, 3, "2,2,-1,0.9,0,-1,0,0,1,0.2", "row 2", "b"},
+};
+
+class BadInputTest : public CliTest, public ::testing::WithParamInterface<BadCase> {};
+
+TEST_P(BadInputTest, RejectedWithLocatedMessageAndNoOutput) {
+  const BadCase& c = GetParam();
+  const std::string bodies = c.in_bodies ? replace_line(kBodies, c.line, c.text) : kBodies;
+  const std::string contacts = c.in_bodies ? kContacts : replace_line(kContacts, c.line, c.text);
+  const RunResult r = solve(bodies, contacts);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  const std::string file = path(c.in_bodies ? "bodies.csv" : "contacts.csv").string();
+  EXPECT_EQ(r.err.rfind("collide: " + file + ":", 0), 0u) << r.err;
+  std::string line = ":";
+  line.append(std::to_string(c.line + 1)).append(": ");
+  EXPECT_NE(r.err.find(line), std::string::npos) << "expected line " << line << " in: " << r.err;
+  // "row 1, column 'px': ..." or "header, column 'wz': ...".
+  const std::string located = std::string(c.row) + ", column '" + c.column + "': ";
+  EXPECT_NE(r.err.find(located), std::string::npos) << "expected \"" << located << "\" in: " << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  EXPECT_TRUE(stray_files().empty()) << "output written: " << stray_files().front();
+}
+
+TEST_P(BadInputTest, PreExistingOutputsUntouched) {
+  const BadCase& c = GetParam();
+  const std::string bodies = c.in_bodies ? replace_line(kBodies, c.line, c.text) : kBodies;
+  const std::string contacts = c.in_bodies ? kContacts : replace_line(kContacts, c.line, c.text);
+  spit(path("ob.csv"), "old bodies\n");
+  spit(path("oj.csv"), "old impulses\n");
+  const RunResult r = solve(bodies, contacts);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(slurp(path("ob.csv")), "old bodies\n");
+  EXPECT_EQ(slurp(path("oj.csv")), "old impulses\n");
+  EXPECT_EQ(stray_files().size(), 2u) << "a temporary file was left behind";
+}
+
+INSTANTIATE_TEST_SUITE_P(Spec, BadInputTest, ::testing::ValuesIn(kBadCases),
+                         [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+TEST_F(CliTest, EmptyBodiesFileIsMissingHeader) {
+  const RunResult r = solve("", kContacts);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(path("bodies.csv").string() + ":1: header, column 'm': missing header"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(stray_files().empty());
+}
+
+TEST_F(CliTest, EmptyContactsFileIsMissingHeader) {
+  const RunResult r = solve(kBodies, "");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(path("contacts.csv").string() + ":1: header, column 'a': missing header"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(stray_files().empty());
+}
+
+TEST_F(CliTest, MissingInputFile) {
+  const RunResult r = run({"solve", "--bodies", path("nope.csv").string(), "--contacts", path("nope2.csv").string(),
+                           "--out-bodies", path("ob.csv").string(), "--out-impulses", path("oj.csv").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("nope.csv"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("ob.csv")));
+}
+
+TEST_F(CliTest, FirstErrorInFileOrderIsReported) {
+  // Two bad rows: the earlier one is reported, whatever the thread count.
+  std::string bodies = replace_line(kBodies, 2, "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,oops");
+  bodies = replace_line(bodies, 3, "-4,2,1,2,1,0,0,0,-2,0.8,0,2,-1,0,0,1,0");
+  for (const char* threads : {"1", "2"}) {
+    const RunResult r = solve(bodies, kContacts, {"--threads", threads});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(":3: row 1, column 'wz'"), std::string::npos) << r.err;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Accepted input variants.
+// ---------------------------------------------------------------------------
+
+TEST_F(CliTest, AcceptsInfSpellingsCrlfAndNoTrailingNewline) {
+  ASSERT_EQ(solve(kBodies, kContacts).exit_code, 0);
+  const std::string reference = slurp(path("oj.csv"));
+  std::string bodies = replace_line(kBodies, 4, "+inf,Infinity,INF,+Infinity,1,0,0,0,0,-5,0,0,0,0,0,0,0");
+  std::string crlf;
+  for (const char c : bodies) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  std::string contacts = kContacts;
+  contacts.pop_back();  // no newline at the end
+  const RunResult r = solve(crlf, contacts);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(path("oj.csv")), reference);
+}
+
+TEST_F(CliTest, NormalWithinToleranceIsNormalised) {
+  ASSERT_EQ(solve(kBodies, kContacts).exit_code, 0);
+  const std::string reference = slurp(path("oj.csv"));
+  // |n| = 1.0009: accepted and normalised to the unit normal of the reference.
+  const RunResult r = solve(kBodies, replace_line(kContacts, 1, "0,3,0,0,0,0,1.0009,0,0.5,0.4"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(path("oj.csv")), reference);
+}
+
+TEST_F(CliTest, EmptySceneWritesHeadersOnly) {
+  const RunResult r = solve("m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n", "a,b,cx,cy,cz,nx,ny,nz,e,mu\n");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(path("ob.csv")), "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n");
+  EXPECT_EQ(slurp(path("oj.csv")), "jx,jy,jz\n");
+}
+
+// ---------------------------------------------------------------------------
+// Results.
+// ---------------------------------------------------------------------------
+
+/// The in-process result of the library on the same files, for comparison.
+template <class T>
+struct LibraryResult {
+  collide::BodyTable<T> table;
+  collide::BodyBuffer<T> bodies;
+  collide::ImpulseBuffer<T> impulses;
+};
+
+template <class T>
+LibraryResult<T> solve_in_process(const fs::path& bodies_file, const fs::path& contacts_file) {
+  LibraryResult<T> r;
+  r.table = collide::read_bodies<T>(bodies_file.string());
+  const auto contacts = collide::read_contacts<T>(contacts_file.string(), r.table.size());
+  r.bodies = collide::to_body_buffer(r.table);
+  r.impulses = collide::ImpulseBuffer<T>(contacts.size());
+  collide::solve(r.bodies.view(), contacts.view(), r.impulses.view());
+  return r;
+}
+
+template <class T>
+void expect_outputs_match_library(const fs::path& bodies, const fs::path& contacts, const fs::path& out_bodies,
+                                  const fs::path& out_impulses) {
+  const LibraryResult<T> lib = solve_in_process<T>(bodies, contacts);
+  const collide::BodyTable<T> out = collide::read_bodies<T>(out_bodies.string());
+  const std::string impulses_text = collide::read_file(out_impulses.string());
+  ASSERT_EQ(out.size(), lib.table.size());
+  const collide::BodyView<const T> v = std::as_const(lib.bodies).view();
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    using Table = collide::BodyTable<T>;
+    // Unchanged columns: bit for bit the input values (inf included).
+    for (std::size_t k = 0; k < Table::vx; ++k) {
+      ASSERT_EQ(std::memcmp(&out.column[k][i], &lib.table.column[k][i], sizeof(T)), 0)
+          << "body " << i << " column " << collide::kBodyColumns[k];
+    }
+    const T expected[6] = {v.v.x[i], v.v.y[i], v.v.z[i], v.w.x[i], v.w.y[i], v.w.z[i]};
+    for (std::size_t k = 0; k < 6; ++k) {
+      ASSERT_EQ(std::memcmp(&out.column[Table::vx + k][i], &expected[k], sizeof(T)), 0)
+          << "body " << i << " column " << collide::kBodyColumns[Table::vx + k];
+    }
+  }
+  // Impulses: read back as T, bit for bit.
+  std::istringstream in(impulses_text);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "jx,jy,jz");
+  const collide::ImpulseView<const T> j = std::as_const(lib.impulses).view();
+  for (std::size_t k = 0; k < j.count; ++k) {
+    ASSERT_TRUE(std::getline(in, line));
+    T x, y, z;
+    const char* p = line.data();
+    const char* e = p + line.size();
+    auto r1 = std::from_chars(p, e, x);
+    auto r2 = std::from_chars(r1.ptr + 1, e, y);
+    auto r3 = std::from_chars(r2.ptr + 1, e, z);
+    ASSERT_EQ(r3.ptr, e) << line;
+    EXPECT_EQ(x, j.j.x[k]);
+    EXPECT_EQ(y, j.j.y[k]);
+    EXPECT_EQ(z, j.j.z[k]);
+  }
+  EXPECT_FALSE(std::getline(in, line)) << "extra impulse rows";
+}
+
+TEST_F(CliTest, DoubleOutputReadsBackToLibraryValues) {
+  ASSERT_EQ(solve(kBodies, kContacts, {"--precision", "double"}).exit_code, 0);
+  expect_outputs_match_library<double>(path("bodies.csv"), path("contacts.csv"), path("ob.csv"), path("oj.csv"));
+}
+
+TEST_F(CliTest, FloatOutputReadsBackToLibraryValues) {
+  ASSERT_EQ(solve(kBodies, kContacts, {"--precision", "float"}).exit_code, 0);
+  expect_outputs_match_library<float>(path("bodies.csv"), path("contacts.csv"), path("ob.csv"), path("oj.csv"));
+}
+
+TEST_F(CliTest, ImmovableBodyKeepsInfAndIsNotMoved) {
+  ASSERT_EQ(solve(kBodies, kContacts).exit_code, 0);
+  const std::string out = slurp(path("ob.csv"));
+  // The ground row is copied through exactly: inf stays "inf", v and w stay 0.
+  EXPECT_NE(out.find("\ninf,inf,inf,inf,1,0,0,0,0,-5,0,0,0,0,0,0,0\n"), std::string::npos) << out;
+}
+
+TEST_F(CliTest, OtherColumnsCopiedUnchanged) {
+  // Values with many digits, an unnormalised quaternion and a partly locked
+  // body: every column but v and w comes out as it went in.
+  const std::string bodies =
+      "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
+      "1.2345678901234567,0.30000000000000004,inf,7e-3,2,0,0,2,1e10,-0.1,3.3333333333333335,1,2,3,4,5,6\n"
+      "inf,1,1,1,0.5,0.5,0.5,0.5,0,0,0,0,0,0,0,0,0\n";
+  const std::string contacts = "a,b,cx,cy,cz,nx,ny,nz,e,mu\n0,1,1e10,-0.5,3,0,-1,0,0.5,0.1\n";
+  ASSERT_EQ(solve(bodies, contacts).exit_code, 0);
+  const collide::BodyTable<double> in = collide::parse_bodies<double>(bodies, "in");
+  const collide::BodyTable<double> out = collide::read_bodies<double>(path("ob.csv").string());
+  for (std::size_t i = 0; i < 2; ++i) {
+    for (std::size_t k = 0; k < collide::BodyTable<double>::vx; ++k) {
+      EXPECT_EQ(out.column[k][i], in.column[k][i]) << "body " << i << " column " << collide::kBodyColumns[k];
+    }
+  }
+  EXPECT_NE(out.column[collide::BodyTable<double>::vy][0], 2.0) << "body 0 should have been moved";
+}
+
+TEST_F(CliTest, PathsAndThreadsGiveIdenticalBytes) {
+  ASSERT_EQ(run({"gen", "--debris", "3000", "--out", dir_.string(), "--friction"}).exit_code, 0);
+  std::string reference_bodies, reference_impulses;
+  for (const char* precision : {"float", "double"}) {
+    bool first = true;
+    for (const char* p : {"simd", "scalar"}) {
+      for (const char* threads : {"1", "2", "0"}) {
+        const RunResult r =
+            run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+                 "--out-bodies", path("ob.csv").string(), "--out-impulses", path("oj.csv").string(), "--precision",
+                 precision, "--path", p, "--threads", threads});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        if (first) {
+          reference_bodies = slurp(path("ob.csv"));
+          reference_impulses = slurp(path("oj.csv"));
+          first = false;
+        } else {
+          EXPECT_EQ(slurp(path("ob.csv")), reference_bodies) << precision << " " << p << " " << threads;
+          EXPECT_EQ(slurp(path("oj.csv")), reference_impulses) << precision << " " << p << " " << threads;
+        }
+      }
+    }
+  }
+}
+
+TEST_F(CliTest, SuccessfulSolveReplacesExistingOutputs) {
+  spit(path("ob.csv"), "old\n");
+  spit(path("oj.csv"), "old\n");
+  ASSERT_EQ(solve(kBodies, kContacts).exit_code, 0);
+  EXPECT_EQ(slurp(path("oj.csv")).rfind("jx,jy,jz\n", 0), 0u);
+  EXPECT_EQ(slurp(path("ob.csv")).rfind("m,Ix,", 0), 0u);
+  EXPECT_EQ(stray_files().size(), 2u) << "temporary files left behind";
+}
+
+TEST_F(CliTest, ExampleSceneSolvesAndChecks) {
+  const fs::path data = fs::path(COLLIDE_DATA_DIR) / "example";
+  const RunResult r =
+      run({"solve", "--bodies", (data / "bodies.csv").string(), "--contacts", (data / "contacts.csv").string(),
+           "--out-bodies", path("ob.csv").string(), "--out-impulses", path("oj.csv").string(), "--check", "--stats"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
+}
+
+// ---------------------------------------------------------------------------
+// --stats and --check.
+// ---------------------------------------------------------------------------
+
+TEST_F(CliTest, StatsIsOneJsonObjectWithTheDocumentedFields) {
+  const RunResult r = solve(kBodies, kContacts, {"--stats", "--precision", "float", "--path", "scalar"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  ASSERT_FALSE(r.err.empty());
+  EXPECT_EQ(r.err.front(), '{');
+  EXPECT_EQ(r.err.substr(r.err.size() - 2), "}\n");
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+  for (const char* field : {"\"collisions\": 4", "\"kernel_seconds\"", "\"collisions_per_second\"",
+                            "\"precision\": \"float\"", "\"threads\"", "\"model\": \"rigid\"", "\"path\": \"scalar\"",
+                            "\"lanes\": 1", "\"batches\"", "\"schedule_seconds\""}) {
+    EXPECT_NE(r.err.find(field), std::string::npos) << field << " missing in " << r.err;
+  }
+  EXPECT_EQ(r.err.find("check"), std::string::npos) << "no check fields without --check";
+}
+
+TEST_F(CliTest, StatsReportsCheck) {
+  const RunResult r = solve(kBodies, kContacts, {"--stats", "--check"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* field :
+       {"\"max_impulse_error_eps\"", "\"max_relative_error\"", "\"error_bound_eps\": 64", "\"check_passed\": true"}) {
+    EXPECT_NE(r.err.find(field), std::string::npos) << field << " missing in " << r.err;
+  }
+}
+
+TEST_F(CliTest, WithoutStatsNothingIsPrinted) {
+  const RunResult r = solve(kBodies, kContacts, {"--check"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+// ---------------------------------------------------------------------------
+// gen.
+// ---------------------------------------------------------------------------
+
+TEST_F(CliTest, GenSameSeedSameBytesDifferentSeedDifferentBytes) {
+  for (const char* kind : {"--pairs", "--debris"}) {
+    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("a").string(), "--seed", "7", "--threads", "1"}).exit_code, 0);
+    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("b").string(), "--seed", "7"}).exit_code, 0);
+    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("c").string(), "--seed", "8"}).exit_code, 0);
+    for (const char* f : {"bodies.csv", "contacts.csv"}) {
+      const std::string a = slurp(path("a") / f);
+      EXPECT_EQ(a, slurp(path("b") / f)) << kind << " " << f;
+      EXPECT_NE(a, slurp(path("c") / f)) << kind << " " << f;
+    }
+    fs::remove_all(path("a"));
+    fs::remove_all(path("b"));
+    fs::remove_all(path("c"));
+  }
+}
+
+TEST_F(CliTest, GenPairsIsAPrefixOfALargerScene) {
+  // Pair k depends on (seed, k) only: the first 100 pairs of 1000 are 100 pairs.
+  ASSERT_EQ(run({"gen", "--pairs", "100", "--out", path("small").string()}).exit_code, 0);
+  ASSERT_EQ(run({"gen", "--pairs", "1000", "--out", path("large").string()}).exit_code, 0);
+  for (const char* f : {"bodies.csv", "contacts.csv"}) {
+    const std::string small = slurp(path("small") / f);
+    const std::string large = slurp(path("large") / f);
+    EXPECT_EQ(large.substr(0, small.size()), small) << f;
+  }
+}
+
+TEST_F(CliTest, GenFrictionDrawsMu) {
+  ASSERT_EQ(run({"gen", "--pairs", "50", "--out", path("f").string(), "--friction"}).exit_code, 0);
+  ASSERT_EQ(run({"gen", "--pairs", "50", "--out", path("n").string()}).exit_code, 0);
+  const auto with = collide::read_contacts<double>((path("f") / "contacts.csv").string(), 100);
+  const auto without = collide::read_contacts<double>((path("n") / "contacts.csv").string(), 100);
+  int positive = 0;
+  for (std::size_t k = 0; k < 50; ++k) {
+    positive += with.record(k).mu > 0 ? 1 : 0;
+    EXPECT_EQ(without.record(k).mu, 0.0);
+    EXPECT_EQ(with.record(k).e, without.record(k).e) << "friction changes only mu";
+  }
+  EXPECT_GT(positive, 40);
+}
+
+TEST_F(CliTest, GenDebrisHasGroundLast) {
+  ASSERT_EQ(run({"gen", "--debris", "400", "--out", dir_.string()}).exit_code, 0);
+  const auto table = collide::read_bodies<double>(path("bodies.csv").string());
+  ASSERT_EQ(table.size(), 201u);
+  EXPECT_TRUE(std::isinf(table.column[0][200]));
+  const auto contacts = collide::read_contacts<double>(path("contacts.csv").string(), table.size());
+  std::size_t ground = 0;
+  for (std::size_t k = 0; k < contacts.size(); ++k) ground += contacts.record(k).b == 200 ? 1 : 0;
+  EXPECT_EQ(ground, 100u);
+  EXPECT_NE(slurp(path("bodies.csv")).find("\ninf,inf,inf,inf,1,0,0,0,"), std::string::npos);
+}
+
+TEST_F(CliTest, GenThenSolveChecksInBothPrecisionsAndPaths) {
+  for (const char* kind : {"--pairs", "--debris"}) {
+    ASSERT_EQ(run({"gen", kind, "2000", "--out", dir_.string(), "--seed", "11", "--friction"}).exit_code, 0);
+    for (const char* precision : {"float", "double"}) {
+      for (const char* p : {"simd", "scalar"}) {
+        const RunResult r =
+            run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+                 "--out-bodies", path("ob.csv").string(), "--out-impulses", path("oj.csv").string(), "--precision",
+                 precision, "--path", p, "--check", "--stats"});
+        EXPECT_EQ(r.exit_code, 0) << kind << " " << precision << " " << p << ": " << r.err;
+        EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
+      }
+    }
+  }
+}
+
+TEST_F(CliTest, GenWritesNothingOnUsageError) {
+  const RunResult r = run({"gen", "--pairs", "ten", "--out", path("x").string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(fs::exists(path("x")));
+}
+
+// ---------------------------------------------------------------------------
+// Usage.
+// ---------------------------------------------------------------------------
+
+TEST_F(CliTest, Help) {
+  for (const std::vector<std::string>& args :
+       std::vector<std::vector<std::string>>{{"--help"}, {"solve", "--help"}, {"gen", "--help"}, {"help"}}) {
+    const RunResult r = run(args);
+    EXPECT_EQ(r.exit_code, 0) << args[0];
+    EXPECT_NE(r.out.find("usage: collide"), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(CliTest, UsageErrorsExitTwo) {
+  spit(path("bodies.csv"), kBodies);
+  spit(path("contacts.csv"), kContacts);
+  const std::string b = path("bodies.csv").string();
+  const std::string c = path("contacts.csv").string();
+  const std::string ob = path("ob.csv").string();
+  const std::string oj = path("oj.csv").string();
+  const std::vector<std::vector<std::string>> cases = {
+      {},
+      {"frobnicate"},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob},                                  // missing option
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses"},                // missing value
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--fast"},  // unknown
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--precision", "half"},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--path", "gpu"},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--threads", "-1"},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", ob},
+      {"solve", "--bodies", b, "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj},
+      {"solve", "stray", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj},
+      {"gen", "--out", path("g").string()},
+      {"gen", "--pairs", "1", "--debris", "1", "--out", path("g").string()},
+      {"gen", "--pairs", "1"},
+      {"gen", "--pairs", "1", "--out", path("g").string(), "--seed", "x"},
+  };
+  for (const auto& args : cases) {
+    const RunResult r = run(args);
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
+    EXPECT_NE(r.err.find("usage: collide"), std::string::npos) << joined << "\n" << r.err;
+  }
+  EXPECT_FALSE(fs::exists(ob));
+  EXPECT_FALSE(fs::exists(oj));
+  EXPECT_FALSE(fs::exists(path("g")));
+}
+
+TEST_F(CliTest, EqualsFormOfOptions) {
+  spit(path("bodies.csv"), kBodies);
+  spit(path("contacts.csv"), kContacts);
+  const RunResult r = run({"solve", "--bodies=" + path("bodies.csv").string(),
+                           "--contacts=" + path("contacts.csv").string(), "--out-bodies=" + path("ob.csv").string(),
+                           "--out-impulses=" + path("oj.csv").string(), "--precision=float"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(path("oj.csv")));
+}
+
+}  // namespace
