@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,6 +29,7 @@
 #include <oneapi/tbb/global_control.h>
 
 #include "collide/error_bound.hpp"
+#include "collide/model.hpp"
 #include "collide/reference.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
@@ -40,7 +42,7 @@ namespace collide::cli {
 const char* const kSolveUsage =
     "usage: collide solve --bodies B.csv --contacts C.csv --out-bodies OB.csv --out-impulses OJ.csv\n"
     "                     [--precision float|double] [--threads N] [--path simd|scalar]\n"
-    "                     [--stats] [--check]\n"
+    "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
     "with their new v and w (all other columns unchanged) and the impulse J on body\n"
@@ -54,6 +56,9 @@ const char* const kSolveUsage =
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
     "  --path P              simd (default) or scalar; results do not depend on it\n"
+    "  --model M             body model of the kernel: rigid (default), sphere or\n"
+    "                        particle when the scene fits it (an error otherwise), or\n"
+    "                        auto for the cheapest that fits; results are the law's\n"
     "  --stats               print one JSON object of statistics on stderr\n"
     "  --check               also run the long double reference and compare the\n"
     "                        impulses; exit 3 if an error exceeds the documented bound\n"
@@ -80,6 +85,8 @@ struct SolveRequest {
   bool want_float = false;
   int threads = 0;
   Path path = Path::simd;
+  bool auto_model = false;
+  Model model = Model::rigid;
   bool stats = false;
   bool check = false;
 };
@@ -140,6 +147,14 @@ int solve_scene(const SolveRequest& req) {
     ref_contacts = convert_contacts<long double>(contacts.view());
   }
 
+  // A smaller model computes the law only for scenes that fit it.
+  Model model = req.model;
+  if (req.auto_model) {
+    model = choose_model(bodies.view(), contacts.view());
+  } else if (const std::string misfit = model_misfit(model, bodies.view(), contacts.view()); !misfit.empty()) {
+    throw std::runtime_error(std::string("--model ") + to_string(model) + " does not fit the scene: " + misfit);
+  }
+
   const auto t_schedule = Clock::now();
   Schedule schedule;
   schedule.build(contacts.view(), bodies.view());
@@ -151,7 +166,7 @@ int solve_scene(const SolveRequest& req) {
   const Solver solver(options);
   ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
-  const SolveStats stats = solver.solve(bodies.view(), contacts.view(), impulses.view(), schedule);
+  const SolveStats stats = solver.solve(model, bodies.view(), contacts.view(), impulses.view(), schedule);
   const double kernel_seconds = seconds_since(t_kernel);
 
   CheckResult check;
@@ -234,6 +249,7 @@ int run_solve(int argc, char** argv) {
                                      {"precision", true},
                                      {"threads", true},
                                      {"path", true},
+                                     {"model", true},
                                      {"stats", false},
                                      {"check", false}});
   if (opt.count("help") != 0) {
@@ -264,6 +280,16 @@ int run_solve(int argc, char** argv) {
       throw UsageError("--path must be simd or scalar, got '" + it->second + "'");
     }
     req.path = it->second == "simd" ? Path::simd : Path::scalar;
+  }
+  if (const auto it = opt.find("model"); it != opt.end()) {
+    const std::string& m = it->second;
+    if (m == "auto") {
+      req.auto_model = true;
+    } else if (m == "rigid" || m == "sphere" || m == "particle") {
+      req.model = m == "rigid" ? Model::rigid : m == "sphere" ? Model::sphere : Model::particle;
+    } else {
+      throw UsageError("--model must be rigid, sphere, particle or auto, got '" + m + "'");
+    }
   }
   req.stats = opt.count("stats") != 0;
   req.check = opt.count("check") != 0;

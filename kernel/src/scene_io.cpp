@@ -2,8 +2,9 @@
 //
 // Design notes
 // ------------
-// * One pass per file over a single in-memory buffer. The data part (after the
-//   header) is cut at line boundaries into chunks; a first parallel pass
+// * One pass per file over the whole text, mapped from the page cache (see
+//   FileBuffer). The data part (after the header) is cut at line boundaries
+//   into chunks; a first parallel pass
 //   counts the lines of each chunk (so every chunk knows the id of its first
 //   row and writes its rows in place), a second parses the chunks in
 //   parallel. Each chunk stops at its first bad value and the earliest
@@ -11,6 +12,10 @@
 //   thread count. Every line after the header is a data row (a blank line in
 //   the middle is an error, trailing blank lines are ignored), hence the line
 //   of row r is r + 2.
+// * Two paths per row: a fast one for the common case (plain numbers, every
+//   check passing) that parses straight through with from_chars, and a
+//   careful one (split, trim, '+', messages) for everything else. Both accept
+//   exactly the same values; the careful one alone builds messages.
 // * Numbers: std::from_chars (correctly rounded, locale-free, accepts inf,
 //   infinity and nan case-insensitively). A leading '+' is allowed. A value
 //   out of the range of T is an error if it overflows and rounds to a
@@ -354,6 +359,61 @@ bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id
   return true;
 }
 
+/// Reads N plain comma-separated numbers filling the whole of [p, e): no
+/// blanks, no '+', nothing out of range. False on anything else, which the
+/// careful path then parses or rejects with a message.
+template <std::size_t N, class T>
+bool fast_numbers(const char* p, const char* e, T* out) {
+  for (std::size_t k = 0; k < N; ++k) {
+    const auto [ptr, ec] = std::from_chars(p, e, out[k]);
+    if (ec != std::errc()) return false;
+    if (k + 1 < N) {
+      if (ptr == e || *ptr != ',') return false;
+      p = ptr + 1;
+    } else if (ptr != e) {
+      return false;
+    }
+  }
+  return true;
+}
+
+/// The value checks of bodies.csv column k, without messages (the fast path).
+template <class T>
+bool body_value_ok(std::size_t k, T v) {
+  if (std::isnan(v)) return false;
+  if (k <= 3) return v > T(0) && std::isfinite(T(1) / v);  // m, Ix, Iy, Iz
+  return std::isfinite(v);
+}
+
+/// Whether q/|q| can be computed in T as the kernel's conversion does:
+/// |q|^2 must be a normal, finite number. Reason in `reason` if not.
+template <class T>
+bool quaternion_ok(T qw, T qx, T qy, T qz, std::string* reason) {
+  if (qw == T(0) && qx == T(0) && qy == T(0) && qz == T(0)) {
+    if (reason) *reason = "zero quaternion (qw, qx, qy, qz are all 0)";
+    return false;
+  }
+  const T q2 = qw * qw + qx * qx + qy * qy + qz * qz;
+  if (!(q2 >= std::numeric_limits<T>::min()) || !std::isfinite(q2)) {
+    if (reason) {
+      *reason = std::string("quaternion cannot be normalised in ") + precision_name<T>() +
+                (std::isfinite(q2) ? ": it is too close to zero" : ": it is too large");
+    }
+    return false;
+  }
+  return true;
+}
+
+/// |n| within kNormalTolerance of 1, judged in double from the T values:
+/// the tolerance is far above either rounding, and double cannot overflow.
+template <class T>
+bool normal_ok(const T* n, double* length) {
+  const double nx = n[0], ny = n[1], nz = n[2];
+  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+  if (length) *length = len;
+  return std::fabs(len - 1.0) <= kNormalTolerance;
+}
+
 /// Splits the text into its header line and its data rows (trailing blank
 /// lines dropped) and checks the header against `names`.
 template <std::size_t N>
@@ -397,11 +457,15 @@ std::string_view check_header(std::string_view text, const std::string& file,
 }
 
 /// Parses the data rows of a file with N columns in parallel chunks.
-/// `prepare(rows)` sizes the destination; `parse_row(fields, row, failure)`
-/// parses one row's N fields and returns false after filling `failure`.
-template <std::size_t N, class Prepare, class ParseRow>
+/// `prepare(rows)` sizes the destination. `fast_row(begin, end, row)` tries
+/// the common case (plain numbers, no blanks, every check passing) and
+/// returns false on anything else; then `parse_row(fields, row, failure)`,
+/// the careful path, parses the row's N fields again and either accepts
+/// them or returns false after filling `failure`. Both paths accept exactly
+/// the same values; the fast one only skips the splitting and trimming.
+template <std::size_t N, class Prepare, class FastRow, class ParseRow>
 void parse_rows(std::string_view data, const std::string& file, const std::array<std::string_view, N>& names,
-                Prepare&& prepare, ParseRow&& parse_row) {
+                Prepare&& prepare, FastRow&& fast_row, ParseRow&& parse_row) {
   if (data.empty()) {
     prepare(std::size_t(0));
     return;
@@ -446,6 +510,11 @@ void parse_rows(std::string_view data, const std::string& file, const std::array
             const char* line_end = nl ? nl : end;
             const char* next = nl ? nl + 1 : end;
             if (line_end > p && line_end[-1] == '\r') --line_end;
+            if (fast_row(p, line_end, row)) {
+              ++row;
+              p = next;
+              continue;
+            }
             FieldCursor cursor(p, line_end);
             std::size_t k = 0;
             for (; k < N && cursor.next(fields[k]); ++k) {
@@ -508,25 +577,25 @@ BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name) {
         return false;
       }
     }
-    // The kernel's conversion divides q by sqrt(|q|^2) in T: |q|^2 must be a
-    // normal finite number there, else q/|q| is NaN or garbage.
-    const T q2 = v[Table::qw] * v[Table::qw] + v[Table::qx] * v[Table::qx] + v[Table::qy] * v[Table::qy] +
-                 v[Table::qz] * v[Table::qz];
-    if (v[Table::qw] == T(0) && v[Table::qx] == T(0) && v[Table::qy] == T(0) && v[Table::qz] == T(0)) {
+    // The kernel's conversion divides q by sqrt(|q|^2) in T.
+    if (!quaternion_ok(v[Table::qw], v[Table::qx], v[Table::qy], v[Table::qz], &failure.reason)) {
       failure.column = Table::qw;
-      failure.reason = "zero quaternion (qw, qx, qy, qz are all 0)";
-      return false;
-    }
-    if (!(q2 >= std::numeric_limits<T>::min()) || !std::isfinite(q2)) {
-      failure.column = Table::qw;
-      failure.reason = std::string("quaternion cannot be normalised in ") + precision_name<T>() +
-                       (std::isfinite(q2) ? ": it is too close to zero" : ": it is too large");
       return false;
     }
     for (std::size_t k = 0; k < 17; ++k) table.column[k][row] = v[k];
     return true;
   };
-  parse_rows(data, file, kBodyColumns, prepare, parse_row);
+  auto fast_row = [&](const char* b, const char* e, std::size_t row) {
+    T v[17];
+    if (!fast_numbers<17>(b, e, v)) return false;
+    for (std::size_t k = 0; k < 17; ++k) {
+      if (!body_value_ok(k, v[k])) return false;
+    }
+    if (!quaternion_ok<T>(v[Table::qw], v[Table::qx], v[Table::qy], v[Table::qz], nullptr)) return false;
+    for (std::size_t k = 0; k < 17; ++k) table.column[k][row] = v[k];
+    return true;
+  };
+  parse_rows(data, file, kBodyColumns, prepare, fast_row, parse_row);
   return table;
 }
 
@@ -585,11 +654,8 @@ ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_nam
       failure.reason = "mu must be >= 0, got " + quoted(f[9]);
       return false;
     }
-    // The length is judged in double from the T values: the tolerance is
-    // far above either rounding, and double cannot overflow here.
-    const double nx = rec.n[0], ny = rec.n[1], nz = rec.n[2];
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    if (!(std::fabs(len - 1.0) <= kNormalTolerance)) {
+    double len = 0;
+    if (!normal_ok(rec.n, &len)) {
       failure.column = 5;
       char buf[64];
       std::snprintf(buf, sizeof buf, "%.9g", len);
@@ -601,7 +667,34 @@ ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_nam
     contacts.set(row, rec);  // normalises n; writes element `row` only
     return true;
   };
-  parse_rows(data, file, kContactColumns, prepare, parse_row);
+  const std::size_t id_limit = std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max());
+  auto fast_row = [&](const char* b, const char* e, std::size_t row) {
+    std::uint64_t ids[2];
+    for (std::uint64_t& id : ids) {
+      const auto [ptr, ec] = std::from_chars(b, e, id);
+      if (ec != std::errc() || ptr == e || *ptr != ',' || id >= id_limit) return false;
+      b = ptr + 1;
+    }
+    if (ids[0] == ids[1]) return false;
+    ContactRecord<T> rec;
+    T v[8];
+    if (!fast_numbers<8>(b, e, v)) return false;
+    for (const T x : v) {
+      if (!std::isfinite(x)) return false;
+    }
+    rec.a = static_cast<BodyIndex>(ids[0]);
+    rec.b = static_cast<BodyIndex>(ids[1]);
+    for (int k = 0; k < 3; ++k) {
+      rec.c[k] = v[k];
+      rec.n[k] = v[3 + k];
+    }
+    rec.e = v[6];
+    rec.mu = v[7];
+    if (!(rec.e >= T(0) && rec.e <= T(1)) || !(rec.mu >= T(0)) || !normal_ok(rec.n, nullptr)) return false;
+    contacts.set(row, rec);
+    return true;
+  };
+  parse_rows(data, file, kContactColumns, prepare, fast_row, parse_row);
   return contacts;
 }
 

@@ -493,6 +493,33 @@ TEST_F(CliTest, WithoutStatsNothingIsPrinted) {
 }
 
 // ---------------------------------------------------------------------------
+// --model.
+// ---------------------------------------------------------------------------
+
+TEST_F(CliTest, ModelThatDoesNotFitIsRejectedAndWritesNothing) {
+  const RunResult r = solve(kBodies, kContacts, {"--model", "sphere"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--model sphere does not fit"), std::string::npos) << r.err;
+  EXPECT_TRUE(stray_files().empty());
+}
+
+TEST_F(CliTest, SmallerModelsOnScenesThatFitThem) {
+  // Equal moments everywhere: the sphere model is the law.
+  const std::string bodies =
+      "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
+      "2,0.8,0.8,0.8,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n"
+      "1.5,0.6,0.6,0.6,0.9238795325112867,0,0,0.3826834323650898,0.8,2.2,0,-0.5,-4,0,0,0,-2\n"
+      "4,2,2,2,1,0,0,0,-2,0.8,0,2,-1,0,0,1,0\n"
+      "inf,inf,inf,inf,1,0,0,0,0,-5,0,0,0,0,0,0,0\n";
+  for (const char* model : {"sphere", "auto"}) {
+    const RunResult r = solve(bodies, kContacts, {"--model", model, "--stats", "--check"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("\"model\": \"sphere\""), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
+  }
+}
+
+// ---------------------------------------------------------------------------
 // gen.
 // ---------------------------------------------------------------------------
 
@@ -599,6 +626,7 @@ TEST_F(CliTest, UsageErrorsExitTwo) {
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--fast"},  // unknown
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--precision", "half"},
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--path", "gpu"},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--model", "soft"},
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--threads", "-1"},
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", ob},
       {"solve", "--bodies", b, "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj},

@@ -21,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/generate.hpp"
 #include "collide/scene_io.hpp"
 
 namespace fs = std::filesystem;
@@ -201,6 +202,42 @@ TEST(SceneIo, LargeFileReportsTheFirstBadRow) {
   EXPECT_EQ(e.row(), 30000u);
   EXPECT_EQ(e.line(), 30002u);
   EXPECT_EQ(e.column(), "m");
+}
+
+/// A blank after every comma sends every row down the careful path.
+std::string with_blanks(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    out += c;
+    if (c == ',') out += ' ';
+  }
+  return out;
+}
+
+TEST(SceneIo, FastAndCarefulPathsAgree) {
+  std::string bodies = kHeader, contacts = kContactHeader;
+  collide::BodyRecord<double> a, b;
+  collide::ContactRecord<double> c;
+  for (std::uint64_t k = 0; k < 2000; ++k) {
+    collide::draw_pair({k, true}, k, a, b, c);
+    collide::append_body_row(bodies, a);
+    collide::append_body_row(bodies, b);
+    collide::append_contact_row(contacts, c);
+  }
+  const auto fast_f = collide::parse_bodies<float>(bodies, "b");
+  const auto slow_f = collide::parse_bodies<float>(with_blanks(bodies), "b");
+  const auto fast_d = collide::parse_bodies<double>(bodies, "b");
+  const auto slow_d = collide::parse_bodies<double>(with_blanks(bodies), "b");
+  for (std::size_t k = 0; k < 17; ++k) {
+    EXPECT_EQ(std::memcmp(fast_f.column[k].data(), slow_f.column[k].data(), 4000 * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(fast_d.column[k].data(), slow_d.column[k].data(), 4000 * sizeof(double)), 0);
+  }
+  const auto fast_c = collide::parse_contacts<float>(contacts, "c", 4000);
+  const auto slow_c = collide::parse_contacts<float>(with_blanks(contacts), "c", 4000);
+  for (std::size_t k = 0; k < 2000; ++k) {
+    const auto x = fast_c.record(k), y = slow_c.record(k);
+    EXPECT_EQ(std::memcmp(&x, &y, sizeof x), 0) << k;
+  }
 }
 
 template <class T, class Bits>

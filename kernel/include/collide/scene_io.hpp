@@ -17,9 +17,9 @@
 // * The parse-from-memory entry points (`parse_bodies`, `parse_contacts`)
 //   take the text and a file name for the messages, so fuzzers and tests can
 //   drive the parser without files.
-// * Speed: the whole file is read into one buffer, split at line boundaries
-//   into chunks that are parsed in parallel (tbb) with std::from_chars; the
-//   first error in file order wins, so messages do not depend on threads.
+// * Speed: the file is mapped, split at line boundaries into chunks that are
+//   parsed in parallel (tbb) with std::from_chars; the first error in file
+//   order wins, so messages do not depend on threads.
 //   Writing formats blocks of rows in parallel with std::to_chars (shortest
 //   round trip: the text reads back to the same T) and writes them in order.
 // * Outputs go through OutputFile: a temporary file in the destination's
