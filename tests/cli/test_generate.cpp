@@ -48,17 +48,17 @@ void expect_valid_and_approaching(const collide::Scene<T>& scene) {
   }
 }
 
-TEST(Generate, PairsApproachInBothPrecisions) {
+TEST(SceneGenerator, PairsApproachInBothPrecisions) {
   expect_valid_and_approaching(collide::generate_pairs<double>(20000, {5, true}));
   expect_valid_and_approaching(collide::generate_pairs<float>(20000, {5, true}));
 }
 
-TEST(Generate, DebrisApproachesInitially) {
+TEST(SceneGenerator, DebrisApproachesInitially) {
   expect_valid_and_approaching(collide::generate_debris<double>(20000, {5, false}));
   expect_valid_and_approaching(collide::generate_debris<float>(20000, {5, false}));
 }
 
-TEST(Generate, PairKIsAPureFunctionOfSeedAndK) {
+TEST(SceneGenerator, PairKIsAPureFunctionOfSeedAndK) {
   const auto scene = collide::generate_pairs<double>(1000, {9, true});
   for (const std::uint64_t k : {0u, 1u, 500u, 999u}) {
     collide::BodyRecord<double> a, b;
@@ -77,13 +77,13 @@ TEST(Generate, PairKIsAPureFunctionOfSeedAndK) {
   EXPECT_EQ(small.contacts.record(7).c[1], scene.contacts.record(7).c[1]);
 }
 
-TEST(Generate, SeedsDiffer) {
+TEST(SceneGenerator, SeedsDiffer) {
   const auto a = collide::generate_pairs<double>(10, {1, false});
   const auto b = collide::generate_pairs<double>(10, {2, false});
   EXPECT_NE(a.contacts.record(0).c[0], b.contacts.record(0).c[0]);
 }
 
-TEST(Generate, FrictionOnlyChangesMu) {
+TEST(SceneGenerator, FrictionOnlyChangesMu) {
   const auto a = collide::generate_pairs<double>(100, {3, false});
   const auto b = collide::generate_pairs<double>(100, {3, true});
   for (std::size_t k = 0; k < 100; ++k) {
@@ -93,7 +93,7 @@ TEST(Generate, FrictionOnlyChangesMu) {
   }
 }
 
-TEST(Generate, DebrisShape) {
+TEST(SceneGenerator, DebrisShape) {
   const std::size_t n = 1000;
   const auto scene = collide::generate_debris<double>(n);
   ASSERT_EQ(scene.bodies.size(), n / 2 + 1);
@@ -114,7 +114,7 @@ TEST(Generate, DebrisShape) {
   EXPECT_GT(*std::max_element(uses.begin(), uses.end() - 1), 1);
 }
 
-TEST(Generate, TinyScenes) {
+TEST(SceneGenerator, TinyScenes) {
   EXPECT_EQ(collide::generate_pairs<float>(0).contacts.size(), 0u);
   const auto d0 = collide::generate_debris<double>(0);
   EXPECT_EQ(d0.contacts.size(), 0u);
