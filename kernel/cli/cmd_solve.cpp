@@ -19,10 +19,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -261,8 +263,14 @@ int run_solve(int argc, char** argv) {
   req.contacts_path = required(opt, "contacts");
   req.out_bodies_path = required(opt, "out-bodies");
   req.out_impulses_path = required(opt, "out-impulses");
-  if (req.out_bodies_path == req.out_impulses_path) {
-    throw UsageError("--out-bodies and --out-impulses must be different files");
+  {
+    // Compared as resolved paths, so "./x.csv" and "x.csv" count as the same.
+    std::error_code ec1, ec2;
+    const auto a = std::filesystem::weakly_canonical(req.out_bodies_path, ec1);
+    const auto b = std::filesystem::weakly_canonical(req.out_impulses_path, ec2);
+    if (req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b)) {
+      throw UsageError("--out-bodies and --out-impulses must be different files");
+    }
   }
   if (const auto it = opt.find("precision"); it != opt.end()) {
     if (it->second != "float" && it->second != "double") {

@@ -447,6 +447,27 @@ TEST_F(CliTest, SuccessfulSolveReplacesExistingOutputs) {
   EXPECT_EQ(stray_files().size(), 2u) << "temporary files left behind";
 }
 
+TEST_F(CliTest, OutputMayReplaceTheInput) {
+  ASSERT_EQ(solve(kBodies, kContacts).exit_code, 0);
+  const std::string expected = slurp(path("ob.csv"));
+  const RunResult r =
+      run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+           "--out-bodies", path("bodies.csv").string(), "--out-impulses", path("oj.csv").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(path("bodies.csv")), expected);
+}
+
+TEST_F(CliTest, UnwritableOutputWritesNothing) {
+  spit(path("bodies.csv"), kBodies);
+  spit(path("contacts.csv"), kContacts);
+  const RunResult r =
+      run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+           "--out-bodies", path("ob.csv").string(), "--out-impulses", path("missing/oj.csv").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("missing/oj.csv"), std::string::npos) << r.err;
+  EXPECT_TRUE(stray_files().empty()) << stray_files().front();
+}
+
 TEST_F(CliTest, ExampleSceneSolvesAndChecks) {
   const fs::path data = fs::path(COLLIDE_DATA_DIR) / "example";
   const RunResult r =
@@ -629,6 +650,7 @@ TEST_F(CliTest, UsageErrorsExitTwo) {
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--model", "soft"},
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj, "--threads", "-1"},
       {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", ob},
+      {"solve", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", (dir_ / "." / "ob.csv").string()},
       {"solve", "--bodies", b, "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj},
       {"solve", "stray", "--bodies", b, "--contacts", c, "--out-bodies", ob, "--out-impulses", oj},
       {"gen", "--out", path("g").string()},
