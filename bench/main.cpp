@@ -8,7 +8,7 @@
 //   then, for each scene x precision x N, one group:
 //     schedule/<scene>/<f32|f64>/n:N      Schedule::build alone
 //     solve/<scene>/<prec>/<scalar|simd>/t:{1,2}/n:N
-//     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp)
+//     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
 // Scenes: pairs (collide::generate_pairs: contact k joins bodies 2k, 2k+1),
 // debris (collide::generate_debris: N/2 movable bodies shared at random plus
 // one immovable ground under 25% of the contacts), and pairs+mu (pairs with
@@ -62,7 +62,10 @@
 //   --sizes=a,b,...  the N to run (default 1e4, 64Ki, 256Ki, 1Mi, 4Mi, 16Mi)
 // Any --benchmark_filter gets "|^triad/" appended so that the bound is always
 // measured. The console table is tabular unless --benchmark_counters_tabular=
-// false is given.
+// false is given; --benchmark_min_time defaults to 0.2 (seconds).
+// Handy: --benchmark_filter='f32.*n:65536' for one size, --benchmark_filter=
+// '^solve/pairs' for one scene, --benchmark_repetitions=3 on a noisy machine
+// (the summary then uses the medians).
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 
@@ -272,8 +275,13 @@ std::string schedule_name(Kind kind, const char* precision, std::size_t n) {
 /// Times `solve_once` with the scene reset before each call (untimed).
 template <class T, class F>
 double timed_solves(benchmark::State& state, Prepared<T>& p, F&& solve_once) {
-  p.reset_for_solve();
-  solve_once();  // warm-up: worker threads started, code and (small) data in cache
+  // Warm-up, for a scene that fits in the LLC: worker threads started, code
+  // and data in cache. A larger scene starts cold anyway, and one more solve
+  // of it would cost seconds for a thread start-up of microseconds.
+  if (!p.exceeds_llc) {
+    p.reset_for_solve();
+    solve_once();
+  }
   double seconds = 0;
   for (auto _ : state) {
     p.reset_for_solve();
@@ -352,6 +360,8 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
   set_counters(state, columns);
 }
 
+constexpr std::size_t kTextbookMaxN = std::size_t{1} << 22;
+
 template <class F>
 void add_row(const std::string& name, F&& f) {
   benchmark::RegisterBenchmark(name.c_str(), std::forward<F>(f))->UseManualTime()->Unit(benchmark::kMicrosecond);
@@ -370,7 +380,11 @@ void register_group(Kind kind, std::size_t n) {
               [=](benchmark::State& s) { solve_row<T>(s, kind, n, path, threads); });
     }
   }
-  add_row(textbook_name(kind, precision, n), [=](benchmark::State& s) { textbook_row<T>(s, kind, n); });
+  // The baseline up to 4Mi: beyond, it is as memory-bound as at 4Mi and costs
+  // tens of seconds per row.
+  if (n <= kTextbookMaxN) {
+    add_row(textbook_name(kind, precision, n), [=](benchmark::State& s) { textbook_row<T>(s, kind, n); });
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -621,13 +635,18 @@ int main(int argc, char** argv) {
 
   // Tabular counters by default: one aligned column per counter.
   std::vector<char*> args(argv, argv + argc);
-  bool tabular_given = false, listing = false;
+  bool tabular_given = false, min_time_given = false, listing = false;
   for (char* a : args) {
     tabular_given |= std::strncmp(a, "--benchmark_counters_tabular", 28) == 0;
+    min_time_given |= std::strncmp(a, "--benchmark_min_time", 20) == 0;
     listing |= std::strcmp(a, "--benchmark_list_tests") == 0 || std::strcmp(a, "--benchmark_list_tests=true") == 0;
   }
   std::string tabular = "--benchmark_counters_tabular=true";
   if (!tabular_given) args.push_back(tabular.data());
+  // 0.2 s of measured time per row rather than 0.5: the smallest rows still
+  // repeat hundreds of times, the largest run once whatever the setting.
+  std::string min_time = "--benchmark_min_time=0.2";
+  if (!min_time_given) args.push_back(min_time.data());
   int args_count = static_cast<int>(args.size());
   args.push_back(nullptr);
   benchmark::Initialize(&args_count, args.data());
