@@ -3,9 +3,11 @@
 // World frame, Eigen 3x3 matrices, Iw^-1 = R diag(1/I) R^T, contacts in input
 // order. No lanes and no local-frame shortcut: this is the independent
 // statement that the local-frame kernel is checked against. It reads the same
-// stored inputs as the kernels (inverse mass, inverse moments, q, n as given)
-// so that a difference measures the kernel's arithmetic, not input rounding;
-// q is normalised here in S, as the law writes R(q / |q|).
+// stored inputs as the kernels (inverse mass, inverse moments, q, n), so that
+// a difference measures the kernel's arithmetic, not input rounding. q and n
+// are normalised here in S, as the law says: a double normal widened to long
+// double is unit only to double precision, and K(n) = 1/ma + 1/mb + ...
+// assumes |n| = 1 (without this the reference was only double-accurate).
 #include <algorithm>
 #include <cmath>
 
@@ -63,7 +65,7 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     RefBody<S> a(bodies, ia);
     RefBody<S> b(bodies, ib);
     const V3 c(contacts.c.x[k], contacts.c.y[k], contacts.c.z[k]);
-    const V3 n(contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]);
+    const V3 n = V3(contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]).normalized();
     const S e = contacts.e ? contacts.e[k] : contacts.uniform_e;
     const S mu = contacts.mu ? contacts.mu[k] : S(0);
 
@@ -78,6 +80,11 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
       const V3 rbd = rb.cross(d);
       return a.inv_mass + b.inv_mass + rad.dot(a.inv_inertia_world * rad) + rbd.dot(b.inv_inertia_world * rbd);
     };
+    // W d, the compliance of the contact: K(d) = d . W d.
+    auto compliance_times = [&](const V3& d) {
+      return V3((a.inv_mass + b.inv_mass) * d + (a.inv_inertia_world * ra.cross(d)).cross(ra) +
+                (b.inv_inertia_world * rb.cross(d)).cross(rb));
+    };
     auto apply = [&](const V3& p) {
       a.v += p * a.inv_mass;
       a.w += a.inv_inertia_world * ra.cross(p);
@@ -91,11 +98,14 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     d.speed_scale = speed_scale();
     d.k_n = inv_effective_mass(n);
     V3 j = V3::Zero();
+    // The scale is defined for every contact with a movable body, approaching
+    // or not: a kernel that rounds a near-zero vn to the other side owes an
+    // error measured against it.
+    if (d.k_n != S(0)) d.impulse_scale = (S(1) + e) * d.speed_scale / d.k_n;
     if (d.vn < S(0) && d.k_n != S(0)) {
       d.jn = -(S(1) + e) * d.vn / d.k_n;
       apply(d.jn * n);
       j = d.jn * n;
-      d.impulse_scale = (S(1) + e) * d.speed_scale / d.k_n;
       if (mu > S(0)) {
         const V3 u2 = relative_velocity();
         const V3 ut = u2 - u2.dot(n) * n;
@@ -104,7 +114,15 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
           const V3 t = ut / ut_len;
           d.k_t = inv_effective_mass(t);
           d.jt = std::min(ut_len / d.k_t, mu * d.jn);
-          d.impulse_scale += speed_scale() / d.k_t;
+          // The friction step rounds twice over: ut carries the rounding of
+          // both velocity evaluations (speed scales before and after the
+          // normal impulse), and t = ut/|ut| inherits it as a direction
+          // error dt that moves K(t) by 2 t.W dt, i.e. relatively by up to
+          // |W t| / K(t) per unit of relative velocity error. That factor is
+          // 1 for an isotropic contact and tens for a long lever arm on a
+          // body with one small moment, where the plain scale was exceeded.
+          d.impulse_scale +=
+              (d.speed_scale + speed_scale()) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t);
           apply(-d.jt * t);
           j -= d.jt * t;
         }

@@ -209,7 +209,7 @@ void expect_model_computes_the_law(Shape shape, bool shared, bool friction) {
   for (std::size_t k = 0; k < j.size(); ++k) {
     const long double dx = j.view().j.x[k] - jr.view().j.x[k], dy = j.view().j.y[k] - jr.view().j.y[k],
                       dz = j.view().j.z[k] - jr.view().j.z[k];
-    const long double scale = diag[k].impulse_scale > 0 ? diag[k].impulse_scale : 2 * diag[k].speed_scale / diag[k].k_n;
+    const long double scale = diag[k].impulse_scale;
     const long double err = std::sqrt(dx * dx + dy * dy + dz * dz);
     worst = std::max(worst, err / (eps * scale));
     acting += diag[k].jn > 0;

@@ -76,7 +76,7 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   k.n[1] = -1;
   c.push_back(k);
   // Third contact, normal +x: the tip has no x velocity, the contact rests:
-  // no impulse, no impulse_scale.
+  // no impulse; the impulse scale is still defined (the normal one).
   k.n[0] = 1, k.n[1] = 0;
   c.push_back(k);
   std::vector<ReferenceContact<S>> d;
@@ -97,7 +97,8 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   EXPECT_EQ(j.view().j.y[1], S(-1.5));
   EXPECT_EQ(d[2].vn, S(0));
   EXPECT_EQ(d[2].jn, S(0));
-  EXPECT_EQ(d[2].impulse_scale, S(0));
+  EXPECT_GT(d[2].speed_scale, S(0));
+  EXPECT_EQ(d[2].impulse_scale, (1 + S(0.5)) * d[2].speed_scale / d[2].k_n);
   EXPECT_EQ(j.view().j.x[2], S(0));
   // The rod: v = -1.25 - 1.5/4, w_z = 2.25 - 0.75 * 1.5; the wall untouched.
   EXPECT_EQ(std::as_const(b).view().v.y[0], S(-1.625));

@@ -322,7 +322,7 @@ TEST(ScheduleOrder, SharedSceneMatchesSequentialReference) {
     const long double dx = a.j.x[k] - r.j.x[k], dy = a.j.y[k] - r.j.y[k], dz = a.j.z[k] - r.j.z[k];
     const long double err = std::sqrt(dx * dx + dy * dy + dz * dz);
     // Contacts the reference finds separating still have a normal scale.
-    const long double scale = diag[k].impulse_scale > 0 ? diag[k].impulse_scale : 2 * diag[k].speed_scale / diag[k].k_n;
+    const long double scale = diag[k].impulse_scale;
     active += diag[k].jn > 0;
     EXPECT_LE(err, kErrorBoundEps * eps * scale) << "contact " << k;
   }

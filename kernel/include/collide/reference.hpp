@@ -29,10 +29,16 @@ struct ReferenceContact {
   /// in precision eps cannot know u better than about eps * speed_scale.
   S speed_scale = 0;
   /// The impulse scale that the error bound uses [N s]:
-  /// (1 + e) speed_scale / K(n), plus speed_scale' / K(t) when friction acts
-  /// (speed_scale' is taken after the normal impulse). |J| <= impulse_scale
-  /// for the normal part, and a kernel error of a few eps * impulse_scale is
-  /// the best a precision-eps evaluation of the law can guarantee.
+  ///   (1 + e) speed_scale / K(n)
+  /// for every contact with a movable body (approaching or not), plus, when
+  /// friction acts,
+  ///   (speed_scale + speed_scale') / K(t) * (1 + |W t| / K(t)),
+  /// where speed_scale' is taken after the normal impulse and W is the
+  /// contact's compliance (K(d) = d . W d): the friction direction t is a
+  /// rounded velocity direction, and K(t) moves with it by up to that factor.
+  /// |J| <= impulse_scale for the normal part, and a kernel error of a few
+  /// eps * impulse_scale is the best a precision-eps evaluation of the law can
+  /// guarantee.
   S impulse_scale = 0;
 };
 
