@@ -1,0 +1,1 @@
+# Sanitizer options; filled in by the issue-6 work.
