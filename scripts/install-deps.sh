@@ -3,7 +3,7 @@
 # Downloads nothing else. Run as root, or with sudo available.
 set -euo pipefail
 
-packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev)
+packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox)
 
 missing=()
 for p in "${packages[@]}"; do
