@@ -1,1 +1,123 @@
-# Install rules and package files; filled in by the issue-7 work.
+# Installation and the package files of the collide library.
+#
+# Design notes
+# ------------
+# * One library, static by default, shared with -DBUILD_SHARED_LIBS=ON (CMake's
+#   own switch, read by add_library in kernel/CMakeLists.txt).
+# * What a consumer needs is exactly the public link interface:
+#     - the headers (C++17, no TBB, no Eigen: both are used only in .cpp files);
+#     - for a static archive, TBB as well, because an archive cannot carry its
+#       own dependencies. The exported target says so ($<LINK_ONLY:TBB::tbb>,
+#       which CMake adds for a PRIVATE dependency of a static library), so the
+#       config file calls find_dependency(TBB) in that case only. Eigen never
+#       reaches the interface (it is a $<BUILD_INTERFACE> dependency).
+# * Three ways in, one target name: find_package(collide) and add_subdirectory
+#   both give collide::collide; pkg-config gives collide.pc, whose -ltbb sits in
+#   Libs.private for a static install (`pkg-config --static`), as pkg-config
+#   intends private dependencies to be spelled.
+# * The .pc file locates its prefix from its own directory (${pcfiledir}), so
+#   `cmake --install build --prefix anywhere` gives a working file without
+#   reconfiguring.
+# * Install rules are generated when collide is the top-level project, or when
+#   an embedding project asks for them (COLLIDE_INSTALL=ON).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+option(COLLIDE_INSTALL "Generate the install rules for collide" ${PROJECT_IS_TOP_LEVEL})
+
+get_target_property(COLLIDE_LIBRARY_TYPE collide TYPE)
+
+# A static archive is often linked into a consumer's shared library, which
+# needs position-independent code; the kernels lose nothing measurable by it on
+# x86-64 (RIP-relative addressing). A caller's CMAKE_POSITION_INDEPENDENT_CODE
+# wins.
+if(NOT DEFINED CMAKE_POSITION_INDEPENDENT_CODE)
+  set_target_properties(collide PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endif()
+# 0.x: a minor release may break the ABI, so the soname carries major.minor.
+set_target_properties(collide PROPERTIES
+  VERSION ${PROJECT_VERSION}
+  SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
+  EXPORT_NAME collide)
+
+if(NOT COLLIDE_INSTALL)
+  return()
+endif()
+
+set(COLLIDE_CMAKE_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/collide)
+
+install(TARGETS collide EXPORT collideTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/kernel/include/collide
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+  FILES_MATCHING PATTERN "*.hpp")
+
+# The command-line tool, when built. A shared build finds its library relative
+# to its own location, so the installed tree can be moved.
+if(TARGET collide_cli)
+  if(COLLIDE_LIBRARY_TYPE STREQUAL "SHARED_LIBRARY")
+    file(RELATIVE_PATH _collide_bin_to_lib ${CMAKE_INSTALL_FULL_BINDIR} ${CMAKE_INSTALL_FULL_LIBDIR})
+    set_target_properties(collide_cli PROPERTIES INSTALL_RPATH "$ORIGIN/${_collide_bin_to_lib}")
+  endif()
+  install(TARGETS collide_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
+
+# --- CMake package: collideConfig.cmake, collideConfigVersion.cmake ---------
+install(EXPORT collideTargets
+  NAMESPACE collide::
+  FILE collideTargets.cmake
+  DESTINATION ${COLLIDE_CMAKE_INSTALL_DIR})
+
+if(COLLIDE_LIBRARY_TYPE STREQUAL "STATIC_LIBRARY")
+  set(COLLIDE_NEEDS_TBB ON)
+else()
+  set(COLLIDE_NEEDS_TBB OFF)
+endif()
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/collideConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/package/collideConfig.cmake
+  INSTALL_DESTINATION ${COLLIDE_CMAKE_INSTALL_DIR})
+# 0.x: only the same major.minor is promised to be compatible.
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/package/collideConfigVersion.cmake
+  VERSION ${PROJECT_VERSION}
+  COMPATIBILITY SameMinorVersion)
+install(FILES
+  ${PROJECT_BINARY_DIR}/package/collideConfig.cmake
+  ${PROJECT_BINARY_DIR}/package/collideConfigVersion.cmake
+  DESTINATION ${COLLIDE_CMAKE_INSTALL_DIR})
+
+# --- pkg-config: collide.pc --------------------------------------------------
+set(COLLIDE_PC_DIR ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}" OR IS_ABSOLUTE "${CMAKE_INSTALL_INCLUDEDIR}")
+  set(COLLIDE_PC_PREFIX "${CMAKE_INSTALL_PREFIX}")
+  set(COLLIDE_PC_LIBDIR "${CMAKE_INSTALL_FULL_LIBDIR}")
+  set(COLLIDE_PC_INCLUDEDIR "${CMAKE_INSTALL_FULL_INCLUDEDIR}")
+else()
+  # Path from <prefix>/<libdir>/pkgconfig back to <prefix>, e.g. "../.." or, for
+  # Debian's multiarch libdir, "../../..".
+  file(RELATIVE_PATH _collide_pc_up /prefix/${COLLIDE_PC_DIR} /prefix)
+  string(REGEX REPLACE "/$" "" _collide_pc_up "${_collide_pc_up}")
+  set(COLLIDE_PC_PREFIX "\${pcfiledir}/${_collide_pc_up}")
+  set(COLLIDE_PC_LIBDIR "\${prefix}/${CMAKE_INSTALL_LIBDIR}")
+  set(COLLIDE_PC_INCLUDEDIR "\${prefix}/${CMAKE_INSTALL_INCLUDEDIR}")
+endif()
+
+set(COLLIDE_PC_LIBS_PRIVATE "")
+if(COLLIDE_NEEDS_TBB)
+  # -L only when TBB is not in a directory the linker searches anyway.
+  get_target_property(_collide_tbb_location TBB::tbb IMPORTED_LOCATION_RELEASE)
+  if(NOT _collide_tbb_location)
+    get_target_property(_collide_tbb_location TBB::tbb IMPORTED_LOCATION)
+  endif()
+  if(_collide_tbb_location)
+    get_filename_component(_collide_tbb_dir ${_collide_tbb_location} DIRECTORY)
+    if(NOT _collide_tbb_dir IN_LIST CMAKE_CXX_IMPLICIT_LINK_DIRECTORIES)
+      string(APPEND COLLIDE_PC_LIBS_PRIVATE "-L${_collide_tbb_dir} ")
+    endif()
+  endif()
+  string(APPEND COLLIDE_PC_LIBS_PRIVATE "-ltbb")
+endif()
+configure_file(${CMAKE_CURRENT_LIST_DIR}/collide.pc.in ${PROJECT_BINARY_DIR}/package/collide.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/package/collide.pc DESTINATION ${COLLIDE_PC_DIR})
