@@ -79,6 +79,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -479,7 +480,10 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
         return it == run.counters.end() ? 0.0 : it->second.value;
       };
       r = Result{counter("coll/s"), counter("GB/s"), counter("bw_frac"), true};
-      if (median) had_median_[key] = true;
+      if (median) {
+        had_median_[key] = true;
+        medians_ = true;
+      }
     }
     inner_->ReportRuns(runs);
   }
@@ -495,6 +499,9 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
     return name;
   }
 
+  /// True when some row ran with repetitions (the summary uses medians).
+  [[nodiscard]] bool medians() const { return medians_; }
+
   [[nodiscard]] Result get(const std::string& name) const {
     const auto it = results_.find(name);
     return it == results_.end() ? Result{} : it->second;
@@ -504,7 +511,19 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
   std::unique_ptr<benchmark::BenchmarkReporter> inner_;
   std::map<std::string, Result> results_;
   std::map<std::string, bool> had_median_;
+  bool medians_ = false;
 };
+
+/// The 1-minute load average: other processes running skew every row.
+double load_average() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  double load = -1;
+  if (f) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = -1;
+    std::fclose(f);
+  }
+  return load;
+}
 
 struct Options {
   std::vector<std::size_t> sizes{10000, 65536, 262144, 1048576, 4194304, 16777216};
@@ -512,7 +531,8 @@ struct Options {
   bool console = true;  // summary to stdout (else stderr, to keep JSON/CSV clean)
 };
 
-void print_summary(const CollectingReporter& rep, const Options& options, bool checks_ok, std::ostream& out) {
+void print_summary(const CollectingReporter& rep, const Options& options, bool checks_ok, double load_before,
+                   std::ostream& out) {
   char line[512];
   auto print = [&](const char* format, auto... args) {
     std::snprintf(line, sizeof line, format, args...);
@@ -521,7 +541,10 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   const auto f32 = "f32";
   const std::size_t cache_n = 65536, stream_n = 4194304;
 
-  print("\n==== collide_bench summary (one run) ====\n");
+  print("\n==== collide_bench summary (%s) ====\n", rep.medians() ? "medians of the repetitions" : "one run");
+  print("load average before/after: %.2f / %.2f on %u CPUs%s\n", load_before, load_average(),
+        std::thread::hardware_concurrency(),
+        load_before > 0.5 ? " -- other processes were running: expect noisy rows, try --benchmark_repetitions=3" : "");
   print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
         std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20) >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
@@ -691,8 +714,9 @@ int main(int argc, char** argv) {
   std::string spec = benchmark::GetBenchmarkFilter();
   if (!spec.empty() && spec != "." && spec != "all" && spec[0] != '-') spec = "(" + spec + ")|^triad/";
   CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
+  const double load_before = load_average();
   benchmark::RunSpecifiedBenchmarks(&reporter, spec);
-  print_summary(reporter, options, checks_ok, info);
+  print_summary(reporter, options, checks_ok, load_before, info);
   benchmark::Shutdown();
   return 0;
 }
