@@ -163,17 +163,23 @@ struct Prepared {
     const std::size_t nb = scene.bodies.size();
     saved.resize(6 * nb);
     const std::array<T*, 6> arrays = velocity_arrays();
-    for (std::size_t i = 0; i < 6; ++i) std::memcpy(saved.data() + i * nb, arrays[i], nb * sizeof(T));
+    for (std::size_t i = 0; i < 6; ++i) {
+      std::memcpy(saved.data() + i * nb, arrays[i], nb * sizeof(T));
+    }
   }
   void restore() {
     const std::size_t nb = scene.bodies.size();
     const std::array<T*, 6> arrays = velocity_arrays();
-    for (std::size_t i = 0; i < 6; ++i) std::memcpy(arrays[i], saved.data() + i * nb, nb * sizeof(T));
+    for (std::size_t i = 0; i < 6; ++i) {
+      std::memcpy(arrays[i], saved.data() + i * nb, nb * sizeof(T));
+    }
   }
   /// Untimed preparation of the next timed solve (see the design notes).
   void reset_for_solve() {
     restore();
-    if (exceeds_llc) evict_caches();
+    if (exceeds_llc) {
+      evict_caches();
+    }
   }
 };
 
@@ -192,7 +198,9 @@ class SceneCache {
   Prepared<T>& get(Kind kind, std::size_t n) {
     const SceneKey key{kind, sizeof(T), n};
     std::unique_ptr<Prepared<T>>& slot = this->slot<T>();
-    if (slot && slot->key == key) return *slot;
+    if (slot && slot->key == key) {
+      return *slot;
+    }
     // Free the old scene before generating the new one: at 16M both would
     // not fit side by side in double.
     float_.reset();
@@ -425,9 +433,13 @@ bool check_scene(Kind kind, std::ostream& out) {
   auto values = [](const auto& result) {
     std::vector<T> out;
     const collide::BodyView<const T> b = result.first.bodies.view();
-    for (const T* a : {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z}) out.insert(out.end(), a, a + b.count);
+    for (const T* a : {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z}) {
+      out.insert(out.end(), a, a + b.count);
+    }
     const collide::ImpulseView<const T> j = result.second.view();
-    for (const T* a : {j.j.x, j.j.y, j.j.z}) out.insert(out.end(), a, a + j.count);
+    for (const T* a : {j.j.x, j.j.y, j.j.z}) {
+      out.insert(out.end(), a, a + j.count);
+    }
     return out;
   };
   const std::vector<T> vs = values(scalar), vv = values(simd), vt = values(textbook);
@@ -468,13 +480,19 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
   bool ReportContext(const Context& context) override { return inner_->ReportContext(context); }
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& run : runs) {
-      if (run.error_occurred) continue;
+      if (run.error_occurred) {
+        continue;
+      }
       // With repetitions, the median aggregate wins over single repetitions.
       const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type == Run::RT_Aggregate && !median) continue;
+      if (run.run_type == Run::RT_Aggregate && !median) {
+        continue;
+      }
       const std::string key = row_key(run);
       Result& r = results_[key];
-      if (r.valid && !median && had_median_[key]) continue;
+      if (r.valid && !median && had_median_[key]) {
+        continue;
+      }
       auto counter = [&](const char* name) {
         const auto it = run.counters.find(name);
         return it == run.counters.end() ? 0.0 : it->second.value;
@@ -519,7 +537,9 @@ double load_average() {
   std::FILE* f = std::fopen("/proc/loadavg", "r");
   double load = -1;
   if (f) {
-    if (std::fscanf(f, "%lf", &load) != 1) load = -1;
+    if (std::fscanf(f, "%lf", &load) != 1) {
+      load = -1;
+    }
     std::fclose(f);
   }
   return load;
@@ -548,7 +568,9 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
         std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20) >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
-  if (!checks_ok) print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
+  if (!checks_ok) {
+    print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
+  }
 
   print("\nTargets                                                   measured   target  \n");
   auto target = [&](const char* what, double value, double goal, const char* unit) {
@@ -586,7 +608,9 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   print("  %-10s %-4s %9s  %9s %9s %9s %9s %9s  %7s\n", "scene", "prec", "N", "scalar/1", "scalar/2", "simd/1",
         "simd/2", "textbook", "bw_frac");
   std::vector<Kind> kinds{Kind::pairs, Kind::debris};
-  if (!options.quick) kinds.push_back(Kind::pairs_mu);
+  if (!options.quick) {
+    kinds.push_back(Kind::pairs_mu);
+  }
   for (Kind kind : kinds) {
     for (const char* precision : {"f32", "f64"}) {
       for (std::size_t n : options.sizes) {
@@ -595,7 +619,9 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
                                 rep.get(solve_name(kind, precision, Path::simd, 1, n)),
                                 rep.get(solve_name(kind, precision, Path::simd, 2, n)),
                                 rep.get(textbook_name(kind, precision, n))};
-        if (std::none_of(rows, rows + 5, [](const Result& r) { return r.valid; })) continue;
+        if (std::none_of(rows, rows + 5, [](const Result& r) { return r.valid; })) {
+          continue;
+        }
         print("  %-10s %-4s %9zu ", kind_name(kind), precision, n);
         for (const Result& r : rows) {
           if (r.valid) {
@@ -643,10 +669,14 @@ Options parse_own_flags(int& argc, char** argv) {
       std::stringstream list(arg.substr(8));
       std::string item;
       while (std::getline(list, item, ',')) {
-        if (!item.empty()) options.sizes.push_back(static_cast<std::size_t>(std::stod(item)));
+        if (!item.empty()) {
+          options.sizes.push_back(static_cast<std::size_t>(std::stod(item)));
+        }
       }
     } else {
-      if (arg.rfind("--benchmark_format=", 0) == 0 && arg != "--benchmark_format=console") options.console = false;
+      if (arg.rfind("--benchmark_format=", 0) == 0 && arg != "--benchmark_format=console") {
+        options.console = false;
+      }
       argv[kept++] = argv[i];
     }
   }
@@ -670,15 +700,21 @@ int main(int argc, char** argv) {
     listing |= std::strcmp(a, "--benchmark_list_tests") == 0 || std::strcmp(a, "--benchmark_list_tests=true") == 0;
   }
   std::string tabular = "--benchmark_counters_tabular=true";
-  if (!tabular_given) args.push_back(tabular.data());
+  if (!tabular_given) {
+    args.push_back(tabular.data());
+  }
   // 0.2 s of measured time per row rather than 0.5: the smallest rows still
   // repeat hundreds of times, the largest run once whatever the setting.
   std::string min_time = "--benchmark_min_time=0.2";
-  if (!min_time_given) args.push_back(min_time.data());
+  if (!min_time_given) {
+    args.push_back(min_time.data());
+  }
   int args_count = static_cast<int>(args.size());
   args.push_back(nullptr);
   benchmark::Initialize(&args_count, args.data());
-  if (benchmark::ReportUnrecognizedArguments(args_count, args.data())) return 1;
+  if (benchmark::ReportUnrecognizedArguments(args_count, args.data())) {
+    return 1;
+  }
 
   std::ostream& info = options.console ? std::cout : std::cerr;
   bool checks_ok = true;
@@ -697,11 +733,17 @@ int main(int argc, char** argv) {
   register_triad();
   const std::vector<std::size_t> mu_sizes{65536, 4194304};
   for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu}) {
-    if (kind == Kind::pairs_mu && options.quick) continue;
+    if (kind == Kind::pairs_mu && options.quick) {
+      continue;
+    }
     for (int precision : {4, 8}) {
-      if (precision == 8 && options.quick) continue;
+      if (precision == 8 && options.quick) {
+        continue;
+      }
       for (std::size_t n : options.sizes) {
-        if (kind == Kind::pairs_mu && std::find(mu_sizes.begin(), mu_sizes.end(), n) == mu_sizes.end()) continue;
+        if (kind == Kind::pairs_mu && std::find(mu_sizes.begin(), mu_sizes.end(), n) == mu_sizes.end()) {
+          continue;
+        }
         if (precision == 4) {
           register_group<float>(kind, n);
         } else {
@@ -712,7 +754,9 @@ int main(int argc, char** argv) {
   }
 
   std::string spec = benchmark::GetBenchmarkFilter();
-  if (!spec.empty() && spec != "." && spec != "all" && spec[0] != '-') spec = "(" + spec + ")|^triad/";
+  if (!spec.empty() && spec != "." && spec != "all" && spec[0] != '-') {
+    spec = "(" + spec + ")|^triad/";
+  }
   CollectingReporter reporter(benchmark::CreateDefaultDisplayReporter());
   const double load_before = load_average();
   benchmark::RunSpecifiedBenchmarks(&reporter, spec);

@@ -27,9 +27,15 @@ std::size_t parse_size(const std::string& text) {
     return 0;
   }
   const char unit = pos < text.size() ? text[pos] : ' ';
-  if (unit == 'K' || unit == 'k') value <<= 10;
-  if (unit == 'M' || unit == 'm') value <<= 20;
-  if (unit == 'G' || unit == 'g') value <<= 30;
+  if (unit == 'K' || unit == 'k') {
+    value <<= 10;
+  }
+  if (unit == 'M' || unit == 'm') {
+    value <<= 20;
+  }
+  if (unit == 'G' || unit == 'g') {
+    value <<= 30;
+  }
   return static_cast<std::size_t>(value);
 }
 
@@ -46,8 +52,12 @@ std::size_t llc_bytes() {
       std::ifstream level_file(dir + "level"), type_file(dir + "type"), size_file(dir + "size");
       std::size_t level = 0;
       std::string type, size;
-      if (!(level_file >> level) || !(type_file >> type) || !(size_file >> size)) continue;
-      if (type == "Instruction") continue;
+      if (!(level_file >> level) || !(type_file >> type) || !(size_file >> size)) {
+        continue;
+      }
+      if (type == "Instruction") {
+        continue;
+      }
       if (level > best_level) {
         best_level = level;
         best_size = parse_size(size);
@@ -63,7 +73,9 @@ double status_bytes(const char* field) {
   std::string line;
   const std::string key = std::string(field) + ":";
   while (std::getline(status, line)) {
-    if (line.compare(0, key.size(), key) != 0) continue;
+    if (line.compare(0, key.size(), key) != 0) {
+      continue;
+    }
     std::istringstream rest(line.substr(key.size()));
     double kib = 0;
     rest >> kib;
@@ -90,7 +102,9 @@ void evict_caches() {
     return b;
   }();
   std::uint64_t sum = 0;
-  for (std::size_t i = 0; i < size; i += 64) sum += buffer[i];
+  for (std::size_t i = 0; i < size; i += 64) {
+    sum += buffer[i];
+  }
   benchmark::DoNotOptimize(sum);
 }
 
@@ -99,7 +113,9 @@ std::size_t evict_buffer_bytes() { return 4 * llc_bytes(); }
 double triad_gbs(int threads) { return threads >= 1 && threads <= 2 ? g_triad[threads] : 0.0; }
 
 void set_triad_gbs(int threads, double gbs) {
-  if (threads >= 1 && threads <= 2) g_triad[threads] = gbs;
+  if (threads >= 1 && threads <= 2) {
+    g_triad[threads] = gbs;
+  }
 }
 
 void set_counters(benchmark::State& state, const Columns& c) {

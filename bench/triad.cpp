@@ -55,7 +55,9 @@ void triad_benchmark(benchmark::State& state, int threads) {
       const float* __restrict pa = a.get();
       const float* __restrict pb = b.get();
       float* __restrict pc = c.get();
-      for (std::size_t i = begin; i < end; ++i) pc[i] = pa[i] + s * pb[i];
+      for (std::size_t i = begin; i < end; ++i) {
+        pc[i] = pa[i] + s * pb[i];
+      }
     });
     benchmark::ClobberMemory();
   };
