@@ -538,7 +538,7 @@ int main(int argc, char** argv) {
       if (pass == 0) {
         // The impulses say which contacts were approaching: the others got J = 0.
         for (std::size_t k = 0; k < contacts.size(); ++k) {
-          resolved += (contacts.jx[k] != 0) | (contacts.jy[k] != 0) | (contacts.jz[k] != 0);
+          resolved += contacts.jx[k] != 0 || contacts.jy[k] != 0 || contacts.jz[k] != 0 ? 1 : 0;
         }
       }
     }
