@@ -478,7 +478,7 @@ bool write_png(const std::string& path, const std::vector<StepRecord>& history, 
       "'' using 1:6 axes x1y2 with lines dt 3 lw 2 title 'resolved (J != 0)'\n"
       "unset y2label\nunset y2tics\nset ytics mirror\nunset grid\n"
       "set title 'final state from above (colour: height)'\nset xlabel 'x [m]'\nset ylabel 'y [m]'\n"
-      "set size ratio -1\nset cblabel 'z [m]'\nset palette rgb 33,13,10\n"
+      "unset key\nset size ratio -1\nset cblabel 'z [m]'\nset palette rgb 33,13,10\n"
       "set style fill solid 0.8 noborder\n"
       "plot $pile using 1:2:3:4 with circles lc palette notitle\n"
       "unset multiplot\n",
