@@ -16,12 +16,13 @@
 //   each group is read from `order`.
 // * Immovable bodies are gathered but never written: many lanes may read the
 //   one ground body at once, none writes it.
-// * Nothing here allocates: the Solver owns its task_arena, the Schedule owns
-//   the order.
+// * Nothing here allocates: the Solver owns its task_arena (or borrows the
+//   caller's, collide/tbb.hpp), the Schedule owns the order.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 
@@ -31,6 +32,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include "collide/solve.hpp"
+#include "collide/tbb.hpp"
 #include "contact_kernel.hpp"
 
 namespace collide {
@@ -231,14 +233,25 @@ void solve_range_any(bool friction, const ViewOfT<M, T>& bodies, const ContactVi
 
 struct Solver::Impl {
   SolverOptions options;
-  tbb::task_arena arena;
+  std::optional<tbb::task_arena> owned;  // empty when the caller's arena is borrowed
+  tbb::task_arena* arena;
 
-  explicit Impl(const SolverOptions& o) : options(o), arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic) {}
+  explicit Impl(const SolverOptions& o)
+      : options(o), owned(std::in_place, o.threads > 0 ? o.threads : tbb::task_arena::automatic), arena(&*owned) {}
+  Impl(const SolverOptions& o, tbb::task_arena& borrowed) : options(o), arena(&borrowed) {}
 };
 
-Solver::Solver(const SolverOptions& options) : impl_(std::make_unique<Impl>(options)) {
+Solver::Solver(const SolverOptions& options) {
   if (options.threads < 0) throw std::invalid_argument("collide::Solver: threads must be >= 0");
-  impl_->arena.initialize();
+  impl_ = std::make_unique<Impl>(options);
+  impl_->arena->initialize();
+}
+Solver::Solver(const ExternalArena& arena, const SolverOptions& options) {
+  if (options.threads != 0) {
+    throw std::invalid_argument("collide::Solver: threads must be 0 in a caller's arena (the arena decides)");
+  }
+  impl_ = std::make_unique<Impl>(options, arena.arena);
+  impl_->arena->initialize();  // no-op for an arena the caller already initialised
 }
 Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
@@ -307,6 +320,8 @@ SolveStats run_schedule(const SolverOptions& opt, tbb::task_arena& arena, const 
   SolveStats stats;
   stats.contacts = contacts.count;
   stats.batches = schedule.batch_count();
+  stats.largest_batch = schedule.largest_batch();
+  stats.conflicts = schedule.conflicts();
   stats.lanes = width;
   stats.threads = arena.max_concurrency();
   stats.model = model_of<M>();
@@ -321,21 +336,21 @@ SolveStats run_schedule(const SolverOptions& opt, tbb::task_arena& arena, const 
 template <class T>
 SolveStats Solver::solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                          const Schedule& schedule) const {
-  return detail::run_schedule<detail::RigidModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+  return detail::run_schedule<detail::RigidModel, T>(impl_->options, *impl_->arena, bodies, contacts, impulses,
                                                      schedule);
 }
 
 template <class T>
 SolveStats Solver::solve(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                          const Schedule& schedule) const {
-  return detail::run_schedule<detail::SphereModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+  return detail::run_schedule<detail::SphereModel, T>(impl_->options, *impl_->arena, bodies, contacts, impulses,
                                                       schedule);
 }
 
 template <class T>
 SolveStats Solver::solve(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                          const Schedule& schedule) const {
-  return detail::run_schedule<detail::ParticleModel, T>(impl_->options, impl_->arena, bodies, contacts, impulses,
+  return detail::run_schedule<detail::ParticleModel, T>(impl_->options, *impl_->arena, bodies, contacts, impulses,
                                                         schedule);
 }
 

@@ -28,7 +28,8 @@ const char* to_string(Path path);
 
 struct SolverOptions {
   Path path = Path::simd;
-  /// Worker threads; 0 means every hardware thread. Results do not depend on it.
+  /// Worker threads; 0 means every hardware thread. Results do not depend on
+  /// it. Must be 0 for a solver running in the caller's arena (collide/tbb.hpp).
   int threads = 0;
   /// Contacts per parallel task inside a batch (rounded up to the lane
   /// width). A batch of fewer than two blocks runs on the calling thread. A
@@ -40,10 +41,12 @@ struct SolverOptions {
 
 /// What a solve did.
 struct SolveStats {
-  std::size_t contacts = 0;  ///< contacts resolved (including those with J = 0)
-  std::size_t batches = 0;   ///< batches run one after another
-  std::size_t lanes = 0;     ///< SIMD width used for this precision
-  int threads = 0;           ///< threads available to the solve
+  std::size_t contacts = 0;       ///< contacts resolved (including those with J = 0)
+  std::size_t batches = 0;        ///< batches run one after another (Schedule::batch_count())
+  std::size_t largest_batch = 0;  ///< contacts in the largest batch (Schedule::largest_batch())
+  std::size_t conflicts = 0;      ///< dependencies the schedule respected (Schedule::conflicts())
+  std::size_t lanes = 0;          ///< SIMD width used for this precision
+  int threads = 0;                ///< threads available to the solve
   Model model = Model::rigid;
   Path path = Path::simd;
   bool friction = false;  ///< the Coulomb step ran (ContactView::mu was set)
@@ -53,11 +56,21 @@ struct SolveStats {
 template <class T>
 std::size_t simd_width();
 
-/// A reusable solver. It owns the worker threads (a tbb::task_arena) and
-/// allocates nothing while solving, so one Solver can run every frame.
+/// A caller's tbb::task_arena, defined in collide/tbb.hpp so that this header
+/// does not need TBB.
+struct ExternalArena;
+
+/// A reusable solver. It owns the worker threads (a tbb::task_arena), or runs
+/// in the caller's arena (collide/tbb.hpp), and allocates nothing while
+/// solving, so one Solver can run every frame. There is no global state: two
+/// solvers never share threads unless their caller shares an arena.
 class Solver {
  public:
   explicit Solver(const SolverOptions& options = {});
+  /// Runs every solve inside the caller's arena instead of owning one; the
+  /// arena must outlive the solver, and options.threads must be 0 (the
+  /// arena's concurrency is used). Prefer collide::make_solver(arena).
+  Solver(const ExternalArena& arena, const SolverOptions& options);
   ~Solver();
   Solver(const Solver&) = delete;
   Solver& operator=(const Solver&) = delete;
