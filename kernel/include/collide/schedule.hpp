@@ -37,9 +37,11 @@ class Schedule {
  public:
   /// Builds the schedule. Bodies with inv_mass == 0 do not conflict.
   /// Precondition: every index is < bodies.count (see validate()).
-  template <class T>
-  void build(const ContactView<T>& contacts, const BodyView<T>& bodies) {
-    build(contacts, bodies.count, bodies.inv_mass);
+  /// `bodies` is any body view (BodyView, SphereView, ParticleView): only
+  /// its count and inverse masses are read.
+  template <class T, template <class> class View>
+  void build(const ContactView<T>& contacts, const View<T>& bodies) {
+    build(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass));
   }
   /// The same for any body model: only the inverse masses matter.
   template <class T>
