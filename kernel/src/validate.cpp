@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace collide {
 namespace {
@@ -20,26 +21,83 @@ Validation fail(const char* view, const char* field, std::size_t i, T value, con
 
 Validation fail_text(const std::string& text) { return {false, text}; }
 
-}  // namespace
+/// The arrays of a body view, each with the rule it must obey.
+template <class T>
+struct BodyField {
+  const char* name;
+  const T* data;
+  bool inverse;  // an inverse mass or moment: finite and >= 0; otherwise finite
+};
 
 template <class T>
-Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
+std::vector<BodyField<T>> fields_of(const BodyView<T>& b) {
+  return {{"inv_mass", b.inv_mass, true},
+          {"inv_inertia.x", b.inv_inertia.x, true},
+          {"inv_inertia.y", b.inv_inertia.y, true},
+          {"inv_inertia.z", b.inv_inertia.z, true},
+          {"q.w", b.q.w, false},
+          {"q.x", b.q.x, false},
+          {"q.y", b.q.y, false},
+          {"q.z", b.q.z, false},
+          {"p.x", b.p.x, false},
+          {"p.y", b.p.y, false},
+          {"p.z", b.p.z, false},
+          {"v.x", b.v.x, false},
+          {"v.y", b.v.y, false},
+          {"v.z", b.v.z, false},
+          {"w.x", b.w.x, false},
+          {"w.y", b.w.y, false},
+          {"w.z", b.w.z, false}};
+}
+template <class T>
+std::vector<BodyField<T>> fields_of(const SphereView<T>& b) {
+  return {{"inv_mass", b.inv_mass, true}, {"inv_inertia", b.inv_inertia, true},
+          {"p.x", b.p.x, false},          {"p.y", b.p.y, false},
+          {"p.z", b.p.z, false},          {"v.x", b.v.x, false},
+          {"v.y", b.v.y, false},          {"v.z", b.v.z, false},
+          {"w.x", b.w.x, false},          {"w.y", b.w.y, false},
+          {"w.z", b.w.z, false}};
+}
+template <class T>
+std::vector<BodyField<T>> fields_of(const ParticleView<T>& b) {
+  return {{"inv_mass", b.inv_mass, true}, {"v.x", b.v.x, false}, {"v.y", b.v.y, false}, {"v.z", b.v.z, false}};
+}
+
+/// The unit quaternion of the rigid model; other models have none.
+template <class T>
+Validation check_orientation(const BodyView<T>& b, std::size_t i) {
+  const double qn = std::sqrt(double(b.q.w[i]) * b.q.w[i] + double(b.q.x[i]) * b.q.x[i] + double(b.q.y[i]) * b.q.y[i] +
+                              double(b.q.z[i]) * b.q.z[i]);
+  if (std::abs(qn - 1.0) > kUnitTolerance) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-4");
+  return {};
+}
+template <class View>
+Validation check_orientation(const View&, std::size_t) {
+  return {};
+}
+
+}  // namespace
+
+template <class T, class View>
+Validation validate_any(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                        bool needs_contact_point) {
   if (impulses.count != contacts.count) {
     return fail_text("impulses.count = " + std::to_string(impulses.count) +
                      " but contacts.count = " + std::to_string(contacts.count));
   }
+  const std::vector<BodyField<T>> fields = fields_of(bodies);
   if (bodies.count > 0) {
-    const T* arrays[] = {
-        bodies.inv_mass, bodies.inv_inertia.x, bodies.inv_inertia.y, bodies.inv_inertia.z, bodies.q.w, bodies.q.x,
-        bodies.q.y,      bodies.q.z,           bodies.p.x,           bodies.p.y,           bodies.p.z, bodies.v.x,
-        bodies.v.y,      bodies.v.z,           bodies.w.x,           bodies.w.y,           bodies.w.z};
-    for (const T* a : arrays) {
-      if (a == nullptr) return fail_text("bodies: an array is null but bodies.count = " + std::to_string(bodies.count));
+    for (const BodyField<T>& f : fields) {
+      if (f.data == nullptr) {
+        return fail_text(std::string("bodies.") + f.name +
+                         " is null but bodies.count = " + std::to_string(bodies.count));
+      }
     }
   }
   if (contacts.count > 0) {
-    if (!contacts.a || !contacts.b || !contacts.c.x || !contacts.c.y || !contacts.c.z || !contacts.n.x ||
-        !contacts.n.y || !contacts.n.z) {
+    const bool no_point = !contacts.c.x || !contacts.c.y || !contacts.c.z;
+    if (!contacts.a || !contacts.b || (needs_contact_point && no_point) || !contacts.n.x || !contacts.n.y ||
+        !contacts.n.z) {
       return fail_text("contacts: an array is null but contacts.count = " + std::to_string(contacts.count));
     }
     if (!impulses.j.x || !impulses.j.y || !impulses.j.z) {
@@ -48,23 +106,12 @@ Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, c
   }
 
   for (std::size_t i = 0; i < bodies.count; ++i) {
-    const std::pair<const char*, const T*> inverse[] = {{"inv_mass", bodies.inv_mass},
-                                                        {"inv_inertia.x", bodies.inv_inertia.x},
-                                                        {"inv_inertia.y", bodies.inv_inertia.y},
-                                                        {"inv_inertia.z", bodies.inv_inertia.z}};
-    for (const auto& [name, a] : inverse) {
-      if (!std::isfinite(a[i]) || a[i] < T(0)) return fail("bodies", name, i, a[i], "must be finite and >= 0");
+    for (const BodyField<T>& f : fields) {
+      const T x = f.data[i];
+      if (f.inverse && (!std::isfinite(x) || x < T(0))) return fail("bodies", f.name, i, x, "must be finite and >= 0");
+      if (!f.inverse && !std::isfinite(x)) return fail("bodies", f.name, i, x, "must be finite");
     }
-    const std::pair<const char*, const T*> finite[] = {
-        {"q.w", bodies.q.w}, {"q.x", bodies.q.x}, {"q.y", bodies.q.y}, {"q.z", bodies.q.z}, {"p.x", bodies.p.x},
-        {"p.y", bodies.p.y}, {"p.z", bodies.p.z}, {"v.x", bodies.v.x}, {"v.y", bodies.v.y}, {"v.z", bodies.v.z},
-        {"w.x", bodies.w.x}, {"w.y", bodies.w.y}, {"w.z", bodies.w.z}};
-    for (const auto& [name, a] : finite) {
-      if (!std::isfinite(a[i])) return fail("bodies", name, i, a[i], "must be finite");
-    }
-    const double qn = std::sqrt(double(bodies.q.w[i]) * bodies.q.w[i] + double(bodies.q.x[i]) * bodies.q.x[i] +
-                                double(bodies.q.y[i]) * bodies.q.y[i] + double(bodies.q.z[i]) * bodies.q.z[i]);
-    if (std::abs(qn - 1.0) > kUnitTolerance) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-4");
+    if (Validation v = check_orientation(bodies, i); !v) return v;
   }
 
   for (std::size_t k = 0; k < contacts.count; ++k) {
@@ -82,7 +129,7 @@ Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, c
                                                        {"c.z", contacts.c.z}, {"n.x", contacts.n.x},
                                                        {"n.y", contacts.n.y}, {"n.z", contacts.n.z}};
     for (const auto& [name, a] : finite) {
-      if (!std::isfinite(a[k])) return fail("contacts", name, k, a[k], "must be finite");
+      if (a != nullptr && !std::isfinite(a[k])) return fail("contacts", name, k, a[k], "must be finite");
     }
     const double nn = std::sqrt(double(contacts.n.x[k]) * contacts.n.x[k] + double(contacts.n.y[k]) * contacts.n.y[k] +
                                 double(contacts.n.z[k]) * contacts.n.z[k]);
@@ -100,7 +147,25 @@ Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, c
   return {};
 }
 
-template Validation validate<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&);
-template Validation validate<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&);
+template <class T>
+Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
+  return validate_any<T>(bodies, contacts, impulses, true);
+}
+template <class T>
+Validation validate(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
+  return validate_any<T>(bodies, contacts, impulses, true);
+}
+template <class T>
+Validation validate(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
+  return validate_any<T>(bodies, contacts, impulses, false);
+}
+
+#define COLLIDE_INSTANTIATE(T)                                                                         \
+  template Validation validate<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&);   \
+  template Validation validate<T>(const SphereView<T>&, const ContactView<T>&, const ImpulseView<T>&); \
+  template Validation validate<T>(const ParticleView<T>&, const ContactView<T>&, const ImpulseView<T>&);
+COLLIDE_INSTANTIATE(float)
+COLLIDE_INSTANTIATE(double)
+#undef COLLIDE_INSTANTIATE
 
 }  // namespace collide

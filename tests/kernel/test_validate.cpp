@@ -86,7 +86,7 @@ TYPED_TEST(Validate, EachRuleRejectsAndNamesTheElement) {
   };
   const std::vector<Rule> rules = {
       {"impulses.count", [](Fixture<T>& f) { f.impulses.count -= 1; }},
-      {"bodies: an array is null", [](Fixture<T>& f) { f.bodies.w.y = nullptr; }},
+      {"bodies.w.y is null", [](Fixture<T>& f) { f.bodies.w.y = nullptr; }},
       {"contacts: an array is null", [](Fixture<T>& f) { f.contacts.n.z = nullptr; }},
       {"impulses: an array is null", [](Fixture<T>& f) { f.impulses.j.x = nullptr; }},
       {"bodies.inv_mass[3]", [](Fixture<T>& f) { f.bodies.inv_mass[3] = -1; }},
@@ -150,6 +150,35 @@ TYPED_TEST(Validate, FirstProblemIsReported) {
   mut(f.contacts.e)[1] = 3;
   const Validation v = f.run();
   EXPECT_NE(v.message.find("bodies.v.x[2]"), std::string::npos) << v.message;
+}
+
+// The smaller models' views are checked on their own fields: a sphere has no
+// orientation to be unit, a particle no contact point to be present, and a
+// bad value in a field the model reads is still named.
+TYPED_TEST(Validate, SphereAndParticleViews) {
+  using T = TypeParam;
+  Fixture<T> f;
+  EXPECT_TRUE(validate(sphere_view(f.bodies), f.contacts, f.impulses));
+  EXPECT_TRUE(validate(particle_view(f.bodies), f.contacts, f.impulses));
+
+  f.bodies.q.w[3] = T(7);  // not unit, but neither model reads q
+  EXPECT_FALSE(f.run());
+  EXPECT_TRUE(validate(sphere_view(f.bodies), f.contacts, f.impulses));
+  EXPECT_TRUE(validate(particle_view(f.bodies), f.contacts, f.impulses));
+
+  ContactView<T> no_point = f.contacts;
+  no_point.c = {};
+  EXPECT_TRUE(validate(particle_view(f.bodies), no_point, f.impulses));
+  EXPECT_FALSE(validate(sphere_view(f.bodies), no_point, f.impulses));
+
+  f.bodies.inv_inertia.x[4] = T(-1);
+  const Validation sphere = validate(sphere_view(f.bodies), f.contacts, f.impulses);
+  EXPECT_NE(sphere.message.find("bodies.inv_inertia[4]"), std::string::npos) << sphere.message;
+  EXPECT_TRUE(validate(particle_view(f.bodies), f.contacts, f.impulses));
+
+  f.bodies.v.z[6] = std::numeric_limits<T>::infinity();
+  const Validation particle = validate(particle_view(f.bodies), f.contacts, f.impulses);
+  EXPECT_NE(particle.message.find("bodies.v.z[6]"), std::string::npos) << particle.message;
 }
 
 }  // namespace

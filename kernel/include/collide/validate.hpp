@@ -31,10 +31,12 @@ struct Validation {
 ///  * e in [0, 1] (per contact, or uniform_e), mu finite and >= 0.
 template <class T>
 Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
-
-extern template Validation validate<float>(const BodyView<float>&, const ContactView<float>&,
-                                           const ImpulseView<float>&);
-extern template Validation validate<double>(const BodyView<double>&, const ContactView<double>&,
-                                            const ImpulseView<double>&);
+/// The same for the sphere model's view (no orientation to check).
+template <class T>
+Validation validate(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
+/// The same for the particle model's view; the contact point may be absent
+/// (contacts.c null), since particles never read it.
+template <class T>
+Validation validate(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
 
 }  // namespace collide
