@@ -3,7 +3,9 @@
 # Downloads nothing else. Run as root, or with sudo available.
 set -euo pipefail
 
-packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox)
+# gnuplot-nox draws the report's plot and the debris example's picture;
+# libbullet-dev gives `collide report` its peer row (optional in CMake).
+packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev)
 
 missing=()
 for p in "${packages[@]}"; do
