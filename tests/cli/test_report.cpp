@@ -1,0 +1,391 @@
+// test_report.cpp - `collide report` as a user runs it.
+//
+// One quick run (`--quick --n 20000 --json --plot`) is shared by the tests
+// of this file (it takes seconds, and every test reads the same outputs):
+//   * the JSON holds every variant: both scenes, friction off and on, the
+//     reference in long double and double, the textbook loop in float and
+//     double, and every kernel row (scalar and SIMD, float and double, every
+//     model, every thread count), plus the Bullet row when the report says
+//     it was built with Bullet;
+//   * every row has the required fields with sane values: positive speed and
+//     bandwidth fraction, kernel errors within the documented bound,
+//     p99 <= max, the reference's own error 0, scalar and SIMD errors
+//     identical (the paths agree bit for bit), small drifts;
+//   * the PNG exists and starts with the PNG signature. gnuplot is a declared
+//     dependency, so without it this test fails rather than skips;
+//   * the table on stdout has a line per row; usage errors exit 2.
+//
+// The JSON is read with a small parser below (no JSON library is a
+// dependency of the project).
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collide/error_bound.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// A minimal JSON reader: objects, arrays, strings (no \u escapes beyond
+// ASCII), numbers, true, false, null.
+// ---------------------------------------------------------------------------
+
+struct Json {
+  enum Kind { null, boolean, number, string, array, object } kind = null;
+  bool b = false;
+  double num = 0;
+  std::string str;
+  std::vector<Json> items;
+  std::map<std::string, Json> fields;
+
+  [[nodiscard]] bool has(const std::string& key) const { return kind == object && fields.count(key) != 0; }
+  [[nodiscard]] const Json& at(const std::string& key) const { return fields.at(key); }
+};
+
+class JsonParser {
+ public:
+  explicit JsonParser(const std::string& text) : s_(text) {}
+  Json parse() {
+    Json v = value();
+    ws();
+    if (i_ != s_.size()) fail("trailing characters");
+    return v;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw std::runtime_error("JSON: " + what + " at offset " + std::to_string(i_));
+  }
+  void ws() {
+    while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\n' || s_[i_] == '\t' || s_[i_] == '\r')) ++i_;
+  }
+  bool eat(char c) {
+    ws();
+    if (i_ < s_.size() && s_[i_] == c) {
+      ++i_;
+      return true;
+    }
+    return false;
+  }
+  void expect(char c) {
+    if (!eat(c)) fail(std::string("expected '") + c + "'");
+  }
+  std::string str() {
+    expect('"');
+    std::string out;
+    while (i_ < s_.size() && s_[i_] != '"') {
+      if (s_[i_] == '\\') {
+        ++i_;
+        if (i_ >= s_.size()) fail("bad escape");
+        const char e = s_[i_];
+        if (e == 'u') {
+          out += static_cast<char>(std::stoi(s_.substr(i_ + 1, 4), nullptr, 16));
+          i_ += 4;
+        } else {
+          out += e == 'n' ? '\n' : e == 't' ? '\t' : e;
+        }
+      } else {
+        out += s_[i_];
+      }
+      ++i_;
+    }
+    if (i_ >= s_.size()) fail("unterminated string");
+    ++i_;
+    return out;
+  }
+  Json value() {
+    ws();
+    if (i_ >= s_.size()) fail("unexpected end");
+    Json v;
+    const char c = s_[i_];
+    if (c == '{') {
+      ++i_;
+      v.kind = Json::object;
+      if (eat('}')) return v;
+      do {
+        ws();
+        const std::string key = str();
+        expect(':');
+        v.fields[key] = value();
+      } while (eat(','));
+      expect('}');
+    } else if (c == '[') {
+      ++i_;
+      v.kind = Json::array;
+      if (eat(']')) return v;
+      do {
+        v.items.push_back(value());
+      } while (eat(','));
+      expect(']');
+    } else if (c == '"') {
+      v.kind = Json::string;
+      v.str = str();
+    } else if (s_.compare(i_, 4, "true") == 0) {
+      v.kind = Json::boolean;
+      v.b = true;
+      i_ += 4;
+    } else if (s_.compare(i_, 5, "false") == 0) {
+      v.kind = Json::boolean;
+      i_ += 5;
+    } else if (s_.compare(i_, 4, "null") == 0) {
+      i_ += 4;
+    } else {
+      std::size_t used = 0;
+      v.kind = Json::number;
+      v.num = std::stod(s_.substr(i_, 40), &used);
+      if (used == 0) fail("bad number");
+      i_ += used;
+    }
+    return v;
+  }
+  const std::string& s_;
+  std::size_t i_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// Running the tool.
+// ---------------------------------------------------------------------------
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (const char c : s) {
+    if (c == '\'') {
+      q += "'\\''";
+    } else {
+      q += c;
+    }
+  }
+  return q + "'";
+}
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+RunResult run(const fs::path& dir, const std::vector<std::string>& args) {
+  std::string cmd = shell_quote(COLLIDE_CLI_PATH);
+  for (const std::string& a : args) {
+    cmd += ' ';
+    cmd += shell_quote(a);
+  }
+  const fs::path out = dir / "_stdout.txt", err = dir / "_stderr.txt";
+  cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+/// The one quick report every test reads.
+class ReportRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(fs::path(COLLIDE_TEST_TMP) / "report");
+    fs::remove_all(*dir_);
+    fs::create_directories(*dir_);
+    result_ = new RunResult(run(*dir_, {"report", "--quick", "--n", "20000", "--json", (*dir_ / "report.json").string(),
+                                        "--plot", (*dir_ / "report.png").string()}));
+    json_ = new Json;
+    if (fs::exists(*dir_ / "report.json")) *json_ = JsonParser(slurp(*dir_ / "report.json")).parse();
+  }
+  static void TearDownTestSuite() {
+    delete json_;
+    delete result_;
+    delete dir_;
+  }
+  static const std::vector<Json>& rows() { return json_->at("rows").items; }
+
+  static fs::path* dir_;
+  static RunResult* result_;
+  static Json* json_;
+};
+fs::path* ReportRun::dir_ = nullptr;
+RunResult* ReportRun::result_ = nullptr;
+Json* ReportRun::json_ = nullptr;
+
+const char* const kRequired[] = {"scene",
+                                 "variant",
+                                 "model",
+                                 "precision",
+                                 "simd",
+                                 "threads",
+                                 "n",
+                                 "collisions_per_second",
+                                 "bandwidth_fraction",
+                                 "max_err_eps",
+                                 "p99_err_eps",
+                                 "max_rel_err",
+                                 "friction",
+                                 "momentum_drift",
+                                 "angular_momentum_drift",
+                                 "energy_drift"};
+
+using Key = std::tuple<std::string, bool, std::string, std::string, std::string, int>;  // scene, friction, variant,
+                                                                                        // precision, model, threads
+Key key_of(const Json& row) {
+  return {row.at("scene").str,     row.at("friction").b, row.at("variant").str,
+          row.at("precision").str, row.at("model").str,  static_cast<int>(row.at("threads").num)};
+}
+
+bool is_kernel(const Json& row) { return row.at("variant").str == "scalar" || row.at("variant").str == "simd"; }
+
+TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
+  ASSERT_EQ(result_->exit_code, 0) << result_->err;
+  EXPECT_NE(result_->out.find("scene   fric variant"), std::string::npos) << result_->out;
+  EXPECT_NE(result_->out.find("wall time"), std::string::npos);
+  ASSERT_EQ(json_->kind, Json::object);
+  // One table line per row: every row's variant and model appear in order.
+  std::size_t lines = 0;
+  std::istringstream table(result_->out);
+  for (std::string line; std::getline(table, line);) {
+    if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0) ++lines;
+  }
+  EXPECT_EQ(lines, rows().size());
+}
+
+TEST_F(ReportRun, JsonHoldsEveryVariant) {
+  ASSERT_TRUE(json_->has("rows")) << result_->err;
+  std::set<Key> seen;
+  for (const Json& row : rows()) {
+    for (const char* field : kRequired) ASSERT_TRUE(row.has(field)) << "missing " << field;
+    EXPECT_TRUE(seen.insert(key_of(row)).second)
+        << "duplicate row " << row.at("scene").str << " " << row.at("variant").str;
+  }
+  std::set<Key> expected;
+  for (const std::string scene : {"pairs", "debris"}) {
+    for (const bool friction : {false, true}) {
+      expected.insert({scene, friction, "reference", "long double", "rigid", 1});
+      expected.insert({scene, friction, "reference", "double", "rigid", 1});
+      expected.insert({scene, friction, "textbook", "float", "rigid", 1});
+      expected.insert({scene, friction, "textbook", "double", "rigid", 1});
+      for (const std::string variant : {"scalar", "simd"}) {
+        for (const std::string precision : {"float", "double"}) {
+          for (const std::string model : {"particle", "sphere", "rigid"}) {
+            for (const int threads : {1, 2}) expected.insert({scene, friction, variant, precision, model, threads});
+          }
+        }
+      }
+    }
+  }
+  // The peer row exists exactly when the report says Bullet was built in.
+  const bool bullet = json_->at("peer").str.rfind("bullet", 0) == 0;
+  if (bullet) expected.insert({"pairs", false, "bullet", "float", "rigid", 1});
+  for (const Key& k : expected) {
+    EXPECT_EQ(seen.count(k), 1U) << "no row for " << std::get<0>(k) << (std::get<1>(k) ? " friction " : " ")
+                                 << std::get<2>(k) << " " << std::get<3>(k) << " " << std::get<4>(k) << " "
+                                 << std::get<5>(k) << " threads";
+  }
+  EXPECT_EQ(seen.size(), expected.size()) << "rows beyond the expected variants";
+}
+
+TEST_F(ReportRun, ValuesAreSane) {
+  ASSERT_TRUE(json_->has("rows"));
+  for (const Json& row : rows()) {
+    SCOPED_TRACE(row.at("scene").str + " " + row.at("variant").str + " " + row.at("precision").str + " " +
+                 row.at("model").str + " t" + std::to_string(static_cast<int>(row.at("threads").num)) +
+                 (row.at("friction").b ? " friction" : ""));
+    EXPECT_EQ(row.at("n").num, 20000);
+    EXPECT_EQ(row.at("simd").b, row.at("variant").str == "simd");
+    ASSERT_EQ(row.at("collisions_per_second").kind, Json::number);
+    EXPECT_GT(row.at("collisions_per_second").num, 0);
+    ASSERT_EQ(row.at("bandwidth_fraction").kind, Json::number);
+    EXPECT_GT(row.at("bandwidth_fraction").num, 0);
+    for (const char* f :
+         {"max_err_eps", "p99_err_eps", "max_rel_err", "momentum_drift", "angular_momentum_drift", "energy_drift"}) {
+      ASSERT_EQ(row.at(f).kind, Json::number) << f << " is not a finite number";
+      EXPECT_GE(row.at(f).num, 0) << f;
+    }
+    EXPECT_LE(row.at("p99_err_eps").num, row.at("max_err_eps").num);
+    if (is_kernel(row)) {
+      EXPECT_LE(row.at("max_err_eps").num, collide::kImpulseErrorBoundEps);
+      EXPECT_GE(row.at("lanes").num, 1);
+    }
+    if (row.at("variant").str == "reference" && row.at("precision").str == "long double") {
+      // The yardstick against itself.
+      EXPECT_EQ(row.at("max_err_eps").num, 0);
+      EXPECT_EQ(row.at("energy_drift").num, 0);
+    }
+    // Every variant solves the law: relative impulse errors stay far below 1
+    // and momentum, angular momentum and energy agree with the reference to
+    // rounding (float eps is 1.2e-7).
+    EXPECT_LT(row.at("max_rel_err").num, 0.5);
+    EXPECT_LT(row.at("momentum_drift").num, 1e-5);
+    EXPECT_LT(row.at("angular_momentum_drift").num, 1e-5);
+    EXPECT_LT(row.at("energy_drift").num, 1e-5);
+  }
+}
+
+TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
+  ASSERT_TRUE(json_->has("rows"));
+  // The paths and thread counts agree bit for bit, so their errors do too.
+  std::map<std::tuple<std::string, bool, std::string, std::string>, double> first;
+  for (const Json& row : rows()) {
+    if (!is_kernel(row)) continue;
+    const auto k =
+        std::make_tuple(row.at("scene").str, row.at("friction").b, row.at("precision").str, row.at("model").str);
+    const auto [it, inserted] = first.emplace(k, row.at("max_err_eps").num);
+    if (!inserted) {
+      EXPECT_EQ(it->second, row.at("max_err_eps").num)
+          << std::get<0>(k) << " " << std::get<2>(k) << " " << std::get<3>(k) << " " << row.at("variant").str;
+    }
+  }
+}
+
+TEST_F(ReportRun, WritesThePng) {
+  // gnuplot is a declared dependency (scripts/install-deps.sh): no skip.
+  ASSERT_TRUE(fs::exists(*dir_ / "report.png")) << "no PNG written; stderr: " << result_->err;
+  const std::string png = slurp(*dir_ / "report.png");
+  ASSERT_GE(png.size(), 8U);
+  EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_GT(png.size(), 10000U) << "suspiciously small plot";
+}
+
+TEST_F(ReportRun, SweepCoversTheRequestedSizes) {
+  ASSERT_TRUE(json_->has("sweep"));
+  std::set<std::pair<std::string, double>> points;
+  for (const Json& p : json_->at("sweep").items) {
+    EXPECT_GT(p.at("collisions_per_second").num, 0);
+    EXPECT_GT(p.at("bandwidth_fraction").num, 0);
+    points.insert({p.at("model").str, p.at("n").num});
+  }
+  for (const std::string model : {"rigid", "particle"}) {
+    for (const double n : {1e4, 1e5, 1e6}) EXPECT_EQ(points.count({model, n}), 1U) << model << " " << n;
+  }
+}
+
+TEST(ReportUsage, BadOptionsExitTwo) {
+  const fs::path dir = fs::path(COLLIDE_TEST_TMP) / "report-usage";
+  fs::create_directories(dir);
+  EXPECT_EQ(run(dir, {"report", "--threads", "0"}).exit_code, 2);
+  EXPECT_EQ(run(dir, {"report", "--n", "many"}).exit_code, 2);
+  EXPECT_EQ(run(dir, {"report", "--bogus"}).exit_code, 2);
+  const RunResult help = run(dir, {"report", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("usage: collide report"), std::string::npos);
+}
+
+}  // namespace
