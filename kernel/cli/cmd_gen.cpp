@@ -37,7 +37,8 @@
 namespace collide::cli {
 
 const char* const kGenUsage =
-    "usage: collide gen (--pairs N | --debris N) --out DIR [--seed S] [--friction] [--threads N]\n"
+    "usage: collide gen (--pairs N | --debris N) --out DIR [--seed S] [--friction]\n"
+    "                   [--model rigid|sphere|particle] [--threads N]\n"
     "\n"
     "Writes a random scene as DIR/bodies.csv and DIR/contacts.csv (DIR is created\n"
     "if needed). The same seed gives the same bytes.\n"
@@ -48,6 +49,9 @@ const char* const kGenUsage =
     "  --out DIR      output directory\n"
     "  --seed S       64-bit seed (default 1)\n"
     "  --friction     draw mu uniformly from [0, 1) (default: mu = 0)\n"
+    "  --model M      bodies that fit model M: rigid (default) as drawn, sphere\n"
+    "                 (Iy = Iz = Ix) or particle (infinite moments, w = 0);\n"
+    "                 every other value is the same for all three\n"
     "  --threads N    worker threads, 0 = all (default 0); the bytes do not depend on it\n";
 
 namespace {
@@ -184,9 +188,14 @@ void write_debris(std::size_t count, const GenerateOptions& options, OutputFile&
 }  // namespace
 
 int run_gen(int argc, char** argv) {
-  const Options opt = parse_options(
-      argc, argv, 2,
-      {{"pairs", true}, {"debris", true}, {"out", true}, {"seed", true}, {"threads", true}, {"friction", false}});
+  const Options opt = parse_options(argc, argv, 2,
+                                    {{"pairs", true},
+                                     {"debris", true},
+                                     {"out", true},
+                                     {"seed", true},
+                                     {"threads", true},
+                                     {"friction", false},
+                                     {"model", true}});
   if (opt.count("help") != 0) {
     std::fputs(kGenUsage, stdout);
     return kExitOk;
@@ -202,6 +211,13 @@ int run_gen(int argc, char** argv) {
   GenerateOptions options;
   if (const auto it = opt.find("seed"); it != opt.end()) options.seed = parse_count("seed", it->second);
   options.friction = opt.count("friction") != 0;
+  if (const auto it = opt.find("model"); it != opt.end()) {
+    const std::string& m = it->second;
+    if (m != "rigid" && m != "sphere" && m != "particle") {
+      throw UsageError("--model must be rigid, sphere or particle, got '" + m + "'");
+    }
+    options.model = m == "rigid" ? Model::rigid : m == "sphere" ? Model::sphere : Model::particle;
+  }
   std::unique_ptr<oneapi::tbb::global_control> limit;
   if (const auto it = opt.find("threads"); it != opt.end()) {
     const unsigned long long threads = parse_count("threads", it->second);

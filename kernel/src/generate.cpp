@@ -118,6 +118,19 @@ void draw_movable_body(CounterRng& rng, double half_extent, BodyRecord<double>& 
   store(uniform_vec(rng, -10.0, 10.0), body.w);
 }
 
+/// Makes a drawn body fit a smaller model (model.hpp), after all of its
+/// draws, so that the scenes of every model share positions, masses and
+/// velocities: a particle cannot rotate and does not spin, a sphere has one
+/// moment.
+void fit_model(Model model, BodyRecord<double>& body) {
+  if (model == Model::particle) {
+    body.I[0] = body.I[1] = body.I[2] = std::numeric_limits<double>::infinity();
+    body.w[0] = body.w[1] = body.w[2] = 0.0;
+  } else if (model == Model::sphere) {
+    body.I[1] = body.I[2] = body.I[0];
+  }
+}
+
 /// u . n for a contact at c, u = (va + wa x ra) - (vb + wb x rb).
 double approach_speed(const BodyRecord<double>& a, const BodyRecord<double>& b, Vec3 c, Vec3 n) {
   const Vec3 ra = c - to_vec(a.p);
@@ -176,6 +189,8 @@ void draw_pair(const GenerateOptions& options, std::uint64_t k, BodyRecord<doubl
   for (;;) {
     draw_movable_body(rng, 100.0, a);
     draw_movable_body(rng, 100.0, b);
+    fit_model(options.model, a);
+    fit_model(options.model, b);
     const Vec3 ra = uniform_vec(rng, -2.0, 2.0);
     const Vec3 rb = uniform_vec(rng, -2.0, 2.0);
     const Vec3 n = unit_vec(rng);
@@ -206,6 +221,7 @@ void draw_debris_body(const GenerateOptions& options, std::size_t contacts, std:
   }
   CounterRng rng(options.seed, kDebrisBodyStream, i);
   draw_movable_body(rng, half, body);
+  fit_model(options.model, body);
 }
 
 void draw_debris_contact(const GenerateOptions& options, std::size_t contacts, std::uint64_t k,

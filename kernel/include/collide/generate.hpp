@@ -13,6 +13,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/model.hpp"
 #include "collide/scene.hpp"
 
 namespace collide {
@@ -21,6 +22,10 @@ struct GenerateOptions {
   std::uint64_t seed = 1;
   /// When true, mu is drawn uniformly from [0, 1]; otherwise mu = 0.
   bool friction = false;
+  /// The body model the scene fits (model.hpp): rigid bodies as drawn;
+  /// sphere: Iy = Iz = Ix; particle: infinite moments and w = 0. Every other
+  /// draw is the same, so the scenes of the three models differ only there.
+  Model model = Model::rigid;
 };
 
 /// Pair k of the "pairs" scene in physical units: bodies a (id 2k) and b
