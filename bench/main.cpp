@@ -84,9 +84,11 @@
 #include <vector>
 
 #include "collide/generate.hpp"
+#include "collide/model.hpp"
 #include "collide/scene.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
+#include "collide/traffic.hpp"
 #include "support.hpp"
 #include "textbook.hpp"
 
@@ -122,8 +124,11 @@ struct SceneKey {
   Kind kind = Kind::pairs;
   std::size_t precision_bytes = 0;
   std::size_t n = 0;
+  collide::Model model = collide::Model::rigid;  // the body model the scene's bodies fit
+  bool friction = false;                         // mu drawn (always for Kind::pairs_mu)
   bool operator==(const SceneKey& o) const {
-    return kind == o.kind && precision_bytes == o.precision_bytes && n == o.n;
+    return kind == o.kind && precision_bytes == o.precision_bytes && n == o.n && model == o.model &&
+           friction == o.friction;
   }
 };
 
@@ -184,19 +189,25 @@ struct Prepared {
 };
 
 template <class T>
-collide::Scene<T> generate(Kind kind, std::size_t n) {
+collide::Scene<T> generate(const SceneKey& key) {
   collide::GenerateOptions options;
   options.seed = 1;
-  options.friction = kind == Kind::pairs_mu;
-  return kind == Kind::debris ? collide::generate_debris<T>(n, options) : collide::generate_pairs<T>(n, options);
+  options.friction = key.friction || key.kind == Kind::pairs_mu;
+  options.model = key.model;
+  return key.kind == Kind::debris ? collide::generate_debris<T>(key.n, options)
+                                  : collide::generate_pairs<T>(key.n, options);
+}
+template <class T>
+collide::Scene<T> generate(Kind kind, std::size_t n) {
+  return generate<T>(SceneKey{kind, sizeof(T), n});
 }
 
 /// Holds the one scene alive at a time.
 class SceneCache {
  public:
   template <class T>
-  Prepared<T>& get(Kind kind, std::size_t n) {
-    const SceneKey key{kind, sizeof(T), n};
+  Prepared<T>& get(Kind kind, std::size_t n, collide::Model model = collide::Model::rigid, bool friction = false) {
+    const SceneKey key{kind, sizeof(T), n, model, friction};
     std::unique_ptr<Prepared<T>>& slot = this->slot<T>();
     if (slot && slot->key == key) {
       return *slot;
@@ -226,16 +237,20 @@ class SceneCache {
   static std::unique_ptr<Prepared<T>> prepare(const SceneKey& key) {
     auto p = std::make_unique<Prepared<T>>();
     p->key = key;
-    p->scene = generate<T>(key.kind, key.n);
+    p->scene = generate<T>(key);
     p->friction = p->scene.contacts.view().mu != nullptr;
     p->impulses.resize(key.n);
     p->save();
     const std::size_t bodies = p->scene.bodies.size();
-    p->exceeds_llc = static_cast<double>(key.n) * static_cast<double>(bytes_per_collision<T>(p->friction)) >
+    p->exceeds_llc = static_cast<double>(key.n) *
+                         static_cast<double>(collide::bytes_per_collision(key.model, sizeof(T), p->friction)) >
                      static_cast<double>(llc_bytes());
 
     MemoryRecord record;
     record.scene = std::string(kind_name(key.kind)) + "/" + precision_name<T>() + "/n:" + std::to_string(key.n);
+    if (key.model != collide::Model::rigid || key.friction) {
+      record.scene += std::string("/") + collide::to_string(key.model) + (key.friction ? "+mu" : "");
+    }
     record.contacts = key.n;
     record.bodies = bodies;
     record.buffer_bytes = static_cast<double>(bodies * 17 * sizeof(T)) +
@@ -273,6 +288,11 @@ SceneCache g_cache;
 std::string solve_name(Kind kind, const char* precision, Path path, int threads, std::size_t n) {
   return std::string("solve/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(path) +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
+}
+std::string model_name(Kind kind, collide::Model model, bool friction, const char* precision, int threads,
+                       std::size_t n) {
+  return std::string("model/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
+         precision + "/simd/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
 std::string textbook_name(Kind kind, const char* precision, std::size_t n) {
   return std::string("textbook/") + kind_name(kind) + "/" + precision + "/t:1/n:" + std::to_string(n);
@@ -326,6 +346,39 @@ void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int
   columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
   state.SetLabel(std::to_string(stats.lanes) + " lanes");
+}
+
+/// One body model on a scene whose bodies fit it (GenerateOptions::model),
+/// through the Model-dispatching Solver::solve: the views of the smaller
+/// models read only their own arrays, so the bytes per collision are the
+/// model's own (collide/traffic.hpp).
+template <class T>
+void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads) {
+  Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
+  collide::SolverOptions options;
+  options.path = Path::simd;
+  options.threads = threads;
+  const collide::Solver solver(options);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  if (!collide::model_misfit(model, bodies, contacts).empty()) {
+    state.SkipWithError("the scene does not fit the model");
+    return;
+  }
+  collide::SolveStats stats;
+  const double seconds =
+      timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
+
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(model, sizeof(T), p.friction));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  columns.batches = static_cast<double>(stats.batches);
+  columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+  state.SetLabel(std::string(collide::to_string(stats.model)) + ", " + std::to_string(stats.lanes) + " lanes");
 }
 
 template <class T>
@@ -393,6 +446,21 @@ void register_group(Kind kind, std::size_t n) {
   // tens of seconds per row.
   if (n <= kTextbookMaxN) {
     add_row(textbook_name(kind, precision, n), [=](benchmark::State& s) { textbook_row<T>(s, kind, n); });
+  }
+}
+
+/// Registers the body-model grid of one scene and precision: every model with
+/// and without friction, SIMD, 1 and 2 threads. Each (model, friction) is its
+/// own scene, generated when its first row runs.
+template <class T>
+void register_models(Kind kind, std::size_t n) {
+  for (const collide::Model model : {collide::Model::particle, collide::Model::sphere, collide::Model::rigid}) {
+    for (const bool friction : {false, true}) {
+      for (const int threads : {1, 2}) {
+        add_row(model_name(kind, model, friction, precision_name<T>(), threads, n),
+                [=](benchmark::State& s) { model_row<T>(s, kind, n, model, friction, threads); });
+      }
+    }
   }
 }
 
@@ -572,13 +640,13 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
   }
 
-  print("\nTargets                                                   measured   target  \n");
+  print("\nTargets                                                                measured   target\n");
   auto target = [&](const char* what, double value, double goal, const char* unit) {
     if (!(value > 0)) {
-      print("  %-55s %9s  >= %4.2f%s  (rows not run)\n", what, "n/a", goal, unit);
+      print("  %-68s %9s  >= %4.2f%s  (rows not run)\n", what, "n/a", goal, unit);
       return;
     }
-    print("  %-55s %8.2f%s  >= %4.2f%s  %s\n", what, value, unit, goal, unit, value >= goal ? "MET" : "MISSED");
+    print("  %-68s %8.2f%s  >= %4.2f%s  %s\n", what, value, unit, goal, unit, value >= goal ? "MET" : "MISSED");
   };
   {
     const Result r = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, stream_n));
@@ -601,6 +669,50 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     const Result p = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, stream_n));
     target("f32 simd t:2 n:4Mi, debris / pairs throughput", d.valid && p.valid ? d.coll_per_s / p.coll_per_s : 0, 0.40,
            "");
+  }
+
+  {
+    using collide::Model;
+    const Result particle = rep.get(model_name(Kind::pairs, Model::particle, false, f32, 2, stream_n));
+    const Result rigid = rep.get(model_name(Kind::pairs, Model::rigid, false, f32, 2, stream_n));
+    target("pairs f32 t:2 n:4Mi, particle / rigid throughput (no friction)",
+           particle.valid && rigid.valid ? particle.coll_per_s / rigid.coll_per_s : 0, 2.0, "x");
+    double lowest = 0;
+    std::string which = "n/a";
+    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+      for (const bool friction : {false, true}) {
+        const Result r = rep.get(model_name(Kind::pairs, model, friction, f32, 2, stream_n));
+        if (r.valid && (which == "n/a" || r.bw_frac < lowest)) {
+          lowest = r.bw_frac;
+          which = std::string(collide::to_string(model)) + (friction ? "+mu" : "");
+        }
+      }
+    }
+    target(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + which + ")").c_str(), lowest, 0.60, "");
+  }
+
+  // The body models: million collisions per second and fraction of each
+  // model's own bandwidth bound, SIMD.
+  print("\nBody models, simd [Mcoll/s at 1 / 2 threads; B/coll; bw_frac at 2 threads]\n");
+  print("  %-7s %-13s %-4s %9s  %8s %8s %6s %7s\n", "scene", "model", "prec", "N", "t:1", "t:2", "B/coll", "bw_frac");
+  for (Kind kind : {Kind::pairs, Kind::debris}) {
+    for (const char* precision : {"f32", "f64"}) {
+      for (std::size_t n : options.sizes) {
+        for (const collide::Model model : {collide::Model::particle, collide::Model::sphere, collide::Model::rigid}) {
+          for (const bool friction : {false, true}) {
+            const Result t1 = rep.get(model_name(kind, model, friction, precision, 1, n));
+            const Result t2 = rep.get(model_name(kind, model, friction, precision, 2, n));
+            if (!t1.valid && !t2.valid) {
+              continue;
+            }
+            const std::size_t bytes = collide::bytes_per_collision(model, precision[1] == '3' ? 4 : 8, friction);
+            const std::string label = std::string(collide::to_string(model)) + (friction ? " + mu" : "");
+            print("  %-7s %-13s %-4s %9zu  %8.1f %8.1f %6zu %7.2f\n", kind_name(kind), label.c_str(), precision, n,
+                  t1.coll_per_s / 1e6, t2.coll_per_s / 1e6, bytes, t2.bw_frac);
+          }
+        }
+      }
+    }
   }
 
   // The whole grid in one table: million collisions per second.
@@ -748,6 +860,26 @@ int main(int argc, char** argv) {
           register_group<float>(kind, n);
         } else {
           register_group<double>(kind, n);
+        }
+      }
+    }
+  }
+
+  // The body-model grid (issue: a scene pays only for what it models) at the
+  // two sizes its targets name: in cache and streaming.
+  for (Kind kind : {Kind::pairs, Kind::debris}) {
+    for (int precision : {4, 8}) {
+      if (precision == 8 && options.quick) {
+        continue;
+      }
+      for (std::size_t n : options.sizes) {
+        if (std::find(mu_sizes.begin(), mu_sizes.end(), n) == mu_sizes.end()) {
+          continue;
+        }
+        if (precision == 4) {
+          register_models<float>(kind, n);
+        } else {
+          register_models<double>(kind, n);
         }
       }
     }

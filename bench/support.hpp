@@ -29,6 +29,7 @@
 #include <string>
 
 #include "collide/contacts.hpp"
+#include "collide/traffic.hpp"
 
 namespace collide_bench {
 
@@ -42,9 +43,7 @@ inline double seconds_between(Clock::time_point t0, Clock::time_point t1) {
 /// once (232 for float without friction, 456 for double).
 template <class T>
 constexpr std::size_t bytes_per_collision(bool friction) {
-  constexpr std::size_t body_values = 1 + 3 + 4 + 3 + 3 + 3 /* read */ + 6 /* write v, w */;
-  const std::size_t contact_values = 3 + 3 + 1 + (friction ? 1 : 0) /* read c, n, e, mu */ + 3 /* write J */;
-  return 2 * body_values * sizeof(T) + 2 * sizeof(collide::BodyIndex) + contact_values * sizeof(T);
+  return collide::bytes_per_collision(collide::Model::rigid, sizeof(T), friction);
 }
 
 /// Size of the last-level cache in bytes, from sysfs (the hypervisor's cpuid,
