@@ -5,7 +5,10 @@ set -euo pipefail
 
 # gnuplot-nox draws the report's plot and the debris example's picture;
 # libbullet-dev gives `collide report` its peer row (optional in CMake).
-packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev)
+# clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
+# scripts/ci-sanitizers.sh.
+packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
+  clang-14 libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do

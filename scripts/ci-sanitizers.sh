@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# CI, after the README's test command (.ci/run): the sanitized and fuzzed runs
+# of issue 6. Any finding fails the run (non-zero exit).
+#
+#   1. ASan + UBSan: one Clang build (Debug, so the kernels' asserts are on,
+#      at -O1; see cmake/sanitizers.cmake) of the library, the CLI, every test
+#      and the fuzzers, then ctest. The `package` tests are left out: they
+#      install the library and build consumers without sanitizer flags (which
+#      cannot link a sanitized archive) and recompile the library, and the
+#      Release stage has run them already.
+#   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 60),
+#      the targets side by side on the available cores, from a scratch copy of
+#      fuzz/corpus/<target>/ (the committed seeds stay as they are). A crash,
+#      UB, a leak, an input over 10 s (-timeout) or over 2 GB (-rss_limit_mb)
+#      stops the target with a non-zero exit; the input is kept under
+#      build-asan/fuzz-artifacts/.
+#   3. TSan: a Clang build of only what the parallel kernel tests need
+#      (determinism, schedule, the caller's-arena solver, the shared-body hard
+#      cases) and ctest on those. TBB's hand-overs reach TSan through the ITT
+#      bridge (tests/tsan/itt_tsan_bridge.cpp); tests/tsan/tbb.supp hides
+#      TBB's own task-memory recycling and nothing else. Last, race_canary
+#      must produce a TSan report in the kernel: proof that the bridge and the
+#      suppressions cannot hide a race on the kernel's data.
+#
+# Build directories: build-asan/ and build-tsan/ next to build/.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/scripts/install-deps.sh"
+
+jobs="$(nproc)"
+fuzz_seconds="${FUZZ_SECONDS:-60}"
+cxx="$(command -v clang++-14 || command -v clang++)"
+stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
+
+# --- 1. ASan + UBSan --------------------------------------------------------
+asan="$root/build-asan"
+stage "ASan+UBSan build"
+cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
+  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON \
+  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF >/dev/null
+cmake --build "$asan" -j"$jobs"
+stage "ASan+UBSan tests"
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE package
+
+# --- 2. Fuzzing -------------------------------------------------------------
+stage "fuzzing, ${fuzz_seconds}s per target"
+targets=(scene_io kernel)
+pids=()
+for t in "${targets[@]}"; do
+  work="$asan/fuzz-work/$t"
+  rm -rf "$work" && mkdir -p "$work/corpus" "$asan/fuzz-artifacts"
+  cp "$root/fuzz/corpus/$t/"* "$work/corpus/"
+  "$asan/fuzz/fuzz_$t" -max_total_time="$fuzz_seconds" -timeout=10 -rss_limit_mb=2048 \
+    -print_final_stats=1 -artifact_prefix="$asan/fuzz-artifacts/$t-" "$work/corpus" >"$work/log" 2>&1 &
+  pids+=($!)
+done
+failed=0
+for i in "${!targets[@]}"; do
+  if wait "${pids[$i]}"; then
+    grep -E "^stat::number_of_executed_units|^Done" "$asan/fuzz-work/${targets[$i]}/log" | tr '\n' ' '
+    echo "(fuzz_${targets[$i]}: clean)"
+  else
+    echo "fuzz_${targets[$i]} FAILED:" >&2
+    tail -n 60 "$asan/fuzz-work/${targets[$i]}/log" >&2
+    failed=1
+  fi
+done
+[ "$failed" -eq 0 ]
+
+# --- 3. TSan on the parallel kernel -------------------------------------------
+tsan="$root/build-tsan"
+stage "TSan build"
+cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DCOLLIDE_SANITIZE=thread \
+  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF >/dev/null
+cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_solver_arena test_hard_shared \
+  collide_itt_tsan collide_race_canary
+stage "TSan tests"
+export INTEL_LIBITTNOTIFY64="$tsan/libcollide_itt_tsan.so"
+export INTEL_ITTNOTIFY_GROUPS=sync
+export TSAN_OPTIONS="suppressions=$root/tests/tsan/tbb.supp"
+ctest --test-dir "$tsan" --output-on-failure -j"$jobs" \
+  -R '^(Scenes/Determinism|Schedule|ScheduleOrder|SolverArena|HardShared)\.'
+# The negative control: TSan must see the canary's race, in the kernel.
+set +e
+"$tsan/collide_race_canary" >"$tsan/race_canary.log" 2>&1
+canary=$?
+set -e
+if [ "$canary" -ne 66 ] || ! grep -q "WARNING: ThreadSanitizer: data race" "$tsan/race_canary.log" ||
+  ! grep -q "kernel/src/" "$tsan/race_canary.log"; then
+  echo "race_canary: TSan did not report the deliberate race in the kernel (exit $canary); the TSan run proves nothing" >&2
+  tail -n 40 "$tsan/race_canary.log" >&2
+  exit 1
+fi
+echo "race_canary: TSan reported the deliberate race, as it must"
+stage "sanitizers and fuzzing passed"
