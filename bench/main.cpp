@@ -752,12 +752,12 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   }
 
   print("\nMemory (schedule budget: 16 B/contact + 8 B/body beyond the caller's buffers)\n");
-  print("  %-26s %9s %9s %9s %10s %10s %9s %8s\n", "scene", "peak_MiB", "buf_MiB", "bench_MiB", "sched_B/c",
+  print("  %-34s %9s %9s %9s %10s %10s %9s %8s\n", "scene", "peak_MiB", "buf_MiB", "bench_MiB", "sched_B/c",
         "sched/bud", "extra_MiB", "xtra/bud");
   for (const MemoryRecord& m : g_memory) {
     const double budget = 16.0 * static_cast<double>(m.contacts) + 8.0 * static_cast<double>(m.bodies);
     const double mib = 1024.0 * 1024.0;
-    print("  %-26s %9.0f %9.0f %9.0f %10.2f %10.2f %9.1f %8.2f%s\n", m.scene.c_str(), m.peak_rss_bytes / mib,
+    print("  %-34s %9.0f %9.0f %9.0f %10.2f %10.2f %9.1f %8.2f%s\n", m.scene.c_str(), m.peak_rss_bytes / mib,
           m.buffer_bytes / mib, m.bench_bytes / mib, m.schedule_bytes / static_cast<double>(m.contacts),
           m.schedule_bytes / budget, m.extra_bytes / mib, m.extra_bytes / budget,
           m.peak_was_reset ? "" : " (peak not resettable)");
