@@ -52,7 +52,7 @@ constexpr std::size_t kChunkPairs = std::size_t{1} << 18;
 
 class BulletPeer {
  public:
-  explicit BulletPeer(std::size_t pairs) : shape_() {
+  explicit BulletPeer(std::size_t pairs) {
     bodies_.reserve(2 * pairs);
     for (std::size_t i = 0; i < 2 * pairs; ++i) {
       btRigidBody::btRigidBodyConstructionInfo info(1, nullptr, &shape_, btVector3(1, 1, 1));

@@ -21,6 +21,8 @@
 //   number of pairs, with the bandwidth bound of each model as a horizontal
 //   line and the N at which the model's working set (bytes_per_collision x N)
 //   fills the L2 caches of the threads and the L3 as vertical lines.
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -279,19 +281,22 @@ class TempDir {
 };
 
 /// Runs argv without a shell; returns the exit status, 127 when it could not
-/// be started. stdout and stderr go to `log`.
+/// be started. stdout and stderr go to `log`. posix_spawn rather than fork:
+/// the process has worker threads, and nothing may allocate between a fork
+/// and the exec.
 int run_program(const std::vector<std::string>& argv, const std::string& log) {
-  const pid_t pid = ::fork();
-  if (pid < 0) return 127;
-  if (pid == 0) {
-    std::FILE* f = std::freopen(log.c_str(), "w", stdout);
-    if (f != nullptr) ::dup2(::fileno(stdout), STDERR_FILENO);
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    ::execvp(args[0], args.data());
-    ::_exit(127);
-  }
+  std::vector<char*> args;
+  args.reserve(argv.size() + 1);
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  if (::posix_spawn_file_actions_init(&actions) != 0) return 127;
+  ::posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ::posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int spawned = ::posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+  ::posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return 127;
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) return 127;
@@ -328,7 +333,7 @@ std::string write_plot(const Report& report, const std::string& png_path) {
     return "gnuplot is not installed (Debian package gnuplot-nox; scripts/install-deps.sh installs it)";
   }
   TempDir dir;
-  const std::filesystem::path tmp = dir.path();
+  const std::filesystem::path& tmp = dir.path();
 
   // Panel 1 data: one file per family, so each gets its own colour.
   const int max_threads = report.machine.triad_threads.empty() ? 1
