@@ -71,8 +71,10 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   c.push_back(k);
   // Second contact, normal -y at the same tip: after the first impulse the
   // rod moves at -2 + 3/4 = -1.25 with spin 9/4, so the tip moves at
-  // -1.25 + 2.25 = +1 along y: vn = -1, K(n) = 1, jn = 1.5,
-  // speed_scale = 1.25 + 2.25 * 1, impulse_scale = 1.5 * 3.5.
+  // -1.25 + 2.25 = +1 along y: vn = -1, K(n) = 1, jn = 1.5. The speed
+  // scale is 1.25 + 2.25 * 1 = 3.5 plus what the rod inherits from the first
+  // contact (scale 3): 3 / m = 0.75 linear and 3 max(1/I) |r| = 3 * 2 * 1 = 6
+  // angular at |r| = 1, so 10.25, and impulse_scale = 1.5 * 10.25.
   k.n[1] = -1;
   c.push_back(k);
   // Third contact, normal +x: the tip has no x velocity, the contact rests:
@@ -92,8 +94,8 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   EXPECT_EQ(d[1].vn, S(-1));
   EXPECT_EQ(d[1].k_n, S(1));
   EXPECT_EQ(d[1].jn, S(1.5));
-  EXPECT_EQ(d[1].speed_scale, S(3.5));
-  EXPECT_EQ(d[1].impulse_scale, S(5.25));
+  EXPECT_EQ(d[1].speed_scale, S(10.25));
+  EXPECT_EQ(d[1].impulse_scale, S(15.375));
   EXPECT_EQ(j.view().j.y[1], S(-1.5));
   EXPECT_EQ(d[2].vn, S(0));
   EXPECT_EQ(d[2].jn, S(0));

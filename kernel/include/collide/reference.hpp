@@ -25,8 +25,12 @@ struct ReferenceContact {
   S jn = 0;   ///< normal impulse magnitude [N s]
   S jt = 0;   ///< friction impulse magnitude [N s]
   /// Sum of the magnitudes of the terms of u: |va| + |wa||ra| + |vb| + |wb||rb|
-  /// [m/s]. The relative velocity is a difference of these terms, so a kernel
-  /// in precision eps cannot know u better than about eps * speed_scale.
+  /// [m/s], plus the velocity uncertainty the two bodies inherit from the
+  /// contacts applied to them before (Ev + Ew |r| per body; Ev grows by
+  /// s / m and Ew by s max(1/I) |r| with every contact on the body, s its
+  /// impulse_scale). The relative velocity is a difference of these terms, so
+  /// a kernel in precision eps cannot know u better than about eps *
+  /// speed_scale. For a body's first contact the inherited part is 0.
   S speed_scale = 0;
   /// The impulse scale that the error bound uses [N s]:
   ///   (1 + e) speed_scale / K(n)
