@@ -662,11 +662,7 @@ void fill_error(ReportRow& row, const ImpulseView<const T>& j, const BodyView<co
     const L dy = L(j.j.y[k]) - ref.j.y[k];
     const L dz = L(j.j.z[k]) - ref.j.z[k];
     const L dj = std::sqrt(dx * dx + dy * dy + dz * dz);
-    const L scale = reference.diagnostics[k].impulse_scale;
-    double err = 0;
-    if (dj != L(0)) {
-      err = scale > L(0) ? static_cast<double>(dj / (L(eps) * scale)) : std::numeric_limits<double>::infinity();
-    }
+    double err = static_cast<double>(normalised_impulse_error<T>(dj, reference.diagnostics[k]));
     if (std::isnan(err)) err = std::numeric_limits<double>::infinity();  // a NaN impulse is the worst error
     errors[k] = err;
     max_err = std::max(max_err, err);

@@ -113,8 +113,7 @@ CheckResult check_impulses(const ImpulseView<const T>& j, const ImpulseView<long
     const L dz = L(j.j.z[k]) - ref.j.z[k];
     const L dj = std::sqrt(dx * dx + dy * dy + dz * dz);
     if (dj == L(0)) continue;
-    const L scale = diag[k].impulse_scale;
-    const double err = scale > L(0) ? static_cast<double>(dj / (eps * scale)) : std::numeric_limits<double>::infinity();
+    const double err = static_cast<double>(normalised_impulse_error<T>(dj, diag[k]));
     if (!(err <= r.max_error_eps)) {
       r.max_error_eps = err;
       r.worst_contact = k;

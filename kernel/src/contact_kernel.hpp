@@ -197,10 +197,26 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
     if (stdx::any_of(may_slide)) {
       const Vec3<V> u = relative_velocity(a, b, ra, rb);
       const Vec3<V> ut = u - n * dot(u, n);
-      const V ut_len = stdx::sqrt(dot(ut, ut));
+      // |ut| without squaring ut itself: scaled by its largest component, so
+      // that subnormal speeds do not underflow to |ut| = 0 (in float,
+      // (1e-39)^2 is 0 and friction vanished) nor speeds above ~1e19
+      // overflow to inf. The scaled vector has length in [1, sqrt(3)].
+      // (Max and magnitude by select, not stdx::max and stdx::abs: std::max
+      // and maxps treat a NaN operand differently, and abs turns the default
+      // NaN positive, after which reordered commutative operations pick NaNs
+      // of either sign; every path must give the same bits, NaN included.)
+      auto larger = [](const V& x, const V& y) { return select(y > x, y, x); };
+      auto magnitude = [](const V& x) { return select(x < V(0), -x, x); };
+      const V big = larger(larger(magnitude(ut.x), magnitude(ut.y)), magnitude(ut.z));
+      const V safe_big = select(big > V(0), big, V(1));
+      const Vec3<V> us{ut.x / safe_big, ut.y / safe_big, ut.z / safe_big};
+      const V us_len = stdx::sqrt(dot(us, us));
+      const V ut_len = big * us_len;
+      // Decided on |ut| itself: 0 when ut is, NaN (no slide) when any
+      // component is NaN, even if `big` picked a finite one.
       const auto sliding = may_slide && (ut_len > V(0));
-      const V safe_len = select(sliding, ut_len, V(1));
-      const Vec3<V> t{ut.x / safe_len, ut.y / safe_len, ut.z / safe_len};
+      const V safe_len = select(sliding, us_len, V(1));
+      const Vec3<V> t{us.x / safe_len, us.y / safe_len, us.z / safe_len};
       const LeverArm<V> tarm_a = lever_arm(a, ra, t);
       const LeverArm<V> tarm_b = lever_arm(b, rb, t);
       const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);

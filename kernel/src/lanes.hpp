@@ -38,6 +38,8 @@
 // on functions that take several 8-lane structs, and an out-of-line call
 // passes them through memory (measured: a third of the time in gather_body).
 #define COLLIDE_LANE_INLINE inline __attribute__((always_inline))
+// The same for the lambdas a kernel passes to its field visitors.
+#define COLLIDE_LANE_LAMBDA __attribute__((always_inline))
 
 namespace collide::detail {
 

@@ -1,7 +1,7 @@
 // reference.cpp - the law of docs/collision-law.md, transcribed.
 //
-// World frame, Eigen 3x3 matrices, Iw^-1 = R diag(1/I) R^T, contacts in input
-// order. No lanes and no local-frame shortcut: this is the independent
+// World frame, Eigen 3x3 matrices, Iw^-1 = R diag(1/I) R^T (applied as its
+// three factors, see RefBody), contacts in input order. No lanes and no local-frame shortcut: this is the independent
 // statement that the local-frame kernel is checked against. It reads the same
 // stored inputs as the kernels (inverse mass, inverse moments, q, n), so that
 // a difference measures the kernel's arithmetic, not input rounding. q and n
@@ -26,8 +26,18 @@ struct RefBody {
   using M3 = Eigen::Matrix<S, 3, 3>;
   S inv_mass;
   S inv_inertia_max;  // the largest eigenvalue of Iw^-1 (0 for an immovable body)
-  M3 inv_inertia_world;
+  M3 rotation;        // R, body to world
+  V3 inv_inertia;     // diag(1/Ix, 1/Iy, 1/Iz), body frame
   V3 p, v, w;
+
+  /// Iw^-1 x = R diag(1/I) R^T x, applied factor by factor. Forming the
+  /// matrix R diag(1/I) R^T first loses the small eigenvalues to the
+  /// rounding of the large one: with a moment ratio of 1e-12 (a needle) the
+  /// formed matrix was off by ~1e-7 relative even in long double, and the
+  /// reference, not the kernel, was wrong.
+  V3 inv_inertia_world(const V3& x) const {
+    return rotation * inv_inertia.cwiseProduct(rotation.transpose() * x);
+  }
 
   RefBody(const BodyView<S>& bodies, std::size_t i) {
     inv_mass = bodies.inv_mass[i];
@@ -37,8 +47,8 @@ struct RefBody {
                                : V3(bodies.inv_inertia.x[i], bodies.inv_inertia.y[i], bodies.inv_inertia.z[i]);
     const Eigen::Quaternion<S> q =
         Eigen::Quaternion<S>(bodies.q.w[i], bodies.q.x[i], bodies.q.y[i], bodies.q.z[i]).normalized();
-    const M3 r = q.toRotationMatrix();
-    inv_inertia_world = r * inv_i.asDiagonal() * r.transpose();
+    rotation = q.toRotationMatrix();
+    inv_inertia = inv_i;
     inv_inertia_max = inv_i.maxCoeff();
     p = V3(bodies.p.x[i], bodies.p.y[i], bodies.p.z[i]);
     v = V3(bodies.v.x[i], bodies.v.y[i], bodies.v.z[i]);
@@ -94,18 +104,31 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     auto inv_effective_mass = [&](const V3& d) {
       const V3 rad = ra.cross(d);
       const V3 rbd = rb.cross(d);
-      return a.inv_mass + b.inv_mass + rad.dot(a.inv_inertia_world * rad) + rbd.dot(b.inv_inertia_world * rbd);
+      return a.inv_mass + b.inv_mass + rad.dot(a.inv_inertia_world(rad)) + rbd.dot(b.inv_inertia_world(rbd));
+    };
+    // How much K(d) moves with the rounding of the lever arms: each body's
+    // term is h . (invI * h) with h = R^T (r x d), and h is computed with
+    // cancellation, to an absolute error of about eps |r| per component, so
+    // K(d) is off by up to eps * 2 sum_bodies |r| sum_i invI_i |h_i|. For a
+    // needle (one inverse moment 1e12 times the others) or a normal nearly
+    // along r (|h| << |r|) that is many times eps K(d).
+    auto lever_sensitivity = [&](const V3& d) {
+      auto body = [&](const RefBody<S>& x, const V3& r) {
+        const V3 h = x.rotation.transpose() * r.cross(d);
+        return r.norm() * x.inv_inertia.dot(h.cwiseAbs());
+      };
+      return S(2) * (body(a, ra) + body(b, rb));
     };
     // W d, the compliance of the contact: K(d) = d . W d.
     auto compliance_times = [&](const V3& d) {
-      return V3((a.inv_mass + b.inv_mass) * d + (a.inv_inertia_world * ra.cross(d)).cross(ra) +
-                (b.inv_inertia_world * rb.cross(d)).cross(rb));
+      return V3((a.inv_mass + b.inv_mass) * d + a.inv_inertia_world(ra.cross(d)).cross(ra) +
+                b.inv_inertia_world(rb.cross(d)).cross(rb));
     };
     auto apply = [&](const V3& p) {
       a.v += p * a.inv_mass;
-      a.w += a.inv_inertia_world * ra.cross(p);
+      a.w += a.inv_inertia_world(ra.cross(p));
       b.v -= p * b.inv_mass;
-      b.w -= b.inv_inertia_world * rb.cross(p);
+      b.w -= b.inv_inertia_world(rb.cross(p));
     };
 
     ReferenceContact<S> d;
@@ -117,7 +140,9 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     // The scale is defined for every contact with a movable body, approaching
     // or not: a kernel that rounds a near-zero vn to the other side owes an
     // error measured against it.
-    if (d.k_n != S(0)) d.impulse_scale = (S(1) + e) * d.speed_scale / d.k_n;
+    if (d.k_n != S(0)) {
+      d.impulse_scale = (S(1) + e) * (d.speed_scale + std::abs(d.vn) * lever_sensitivity(n) / d.k_n) / d.k_n;
+    }
     if (d.vn < S(0) && d.k_n != S(0)) {
       d.jn = -(S(1) + e) * d.vn / d.k_n;
       apply(d.jn * n);
@@ -137,8 +162,12 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
           // |W t| / K(t) per unit of relative velocity error. That factor is
           // 1 for an isotropic contact and tens for a long lever arm on a
           // body with one small moment, where the plain scale was exceeded.
-          d.impulse_scale +=
-              (d.speed_scale + speed_scale()) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t);
+          // And on the sliding side jt = mu jn carries mu times the error of
+          // jn (mu may exceed 1).
+          d.impulse_scale =
+              (S(1) + mu) * d.impulse_scale +
+              (d.speed_scale + speed_scale()) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
+              d.jt * lever_sensitivity(t) / d.k_t;
           apply(-d.jt * t);
           j -= d.jt * t;
         }

@@ -159,9 +159,9 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   BodyLanes<M, V> b;
   if (paired) {
     read_bodies<M, V, T>(bodies, a, b,
-                         [&](const T* field, V& la, V& lb) { load_deinterleaved(field + ia[0], la, lb); });
+                         [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + ia[0], la, lb); });
   } else {
-    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) {
+    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
       la = gather<V>(field, ia);
       lb = gather<V>(field, ib);
     });
@@ -183,9 +183,9 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   const auto movable_b = b.inv_mass != V(0);
   if (paired && stdx::all_of(movable_a && movable_b)) {
     write_bodies<M, V, T>(bodies, a, b,
-                          [&](T* field, const V& la, const V& lb) { store_interleaved(la, lb, field + ia[0]); });
+                          [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA { store_interleaved(la, lb, field + ia[0]); });
   } else {
-    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) {
+    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
       scatter(la, field, ia, movable_a);
       scatter(lb, field, ib, movable_b);
     });

@@ -80,8 +80,7 @@ L normalised_error(const ImpulseBuffer<T>& j, const Reference& ref, std::size_t 
   const L dx = L(a.j.x[k]) - r.j.x[k], dy = L(a.j.y[k]) - r.j.y[k], dz = L(a.j.z[k]) - r.j.z[k];
   const L err = std::sqrt(dx * dx + dy * dy + dz * dz);
   if (err == 0) return 0;
-  const L scale = ref.diag[k].impulse_scale;
-  return scale > 0 ? err / (L(std::numeric_limits<T>::epsilon()) * scale) : std::numeric_limits<L>::infinity();
+  return normalised_impulse_error<T>(err, ref.diag[k]);
 }
 
 struct ErrorStats {

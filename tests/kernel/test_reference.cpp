@@ -73,8 +73,9 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   // rod moves at -2 + 3/4 = -1.25 with spin 9/4, so the tip moves at
   // -1.25 + 2.25 = +1 along y: vn = -1, K(n) = 1, jn = 1.5. The speed
   // scale is 1.25 + 2.25 * 1 = 3.5 plus what the rod inherits from the first
-  // contact (scale 3): 3 / m = 0.75 linear and 3 max(1/I) |r| = 3 * 2 * 1 = 6
-  // angular at |r| = 1, so 10.25, and impulse_scale = 1.5 * 10.25.
+  // contact (scale 7.5): 7.5 / m = 1.875 linear and 7.5 max(1/I) |r| =
+  // 7.5 * 2 * 1 = 15 angular at |r| = 1, so 20.375, and impulse_scale =
+  // 1.5 * (20.375 + 1 * 1.5 / 1).
   k.n[1] = -1;
   c.push_back(k);
   // Third contact, normal +x: the tip has no x velocity, the contact rests:
@@ -89,13 +90,16 @@ TYPED_TEST(ReferenceTyped, DiagnosticsOfRodOnWall) {
   EXPECT_EQ(d[0].jt, S(0));  // the tip does not slide: ut = 0, no friction
   EXPECT_EQ(d[0].k_t, S(0));
   EXPECT_EQ(d[0].speed_scale, S(2));
-  EXPECT_EQ(d[0].impulse_scale, S(3));
+  // The lever-arm term: r x n = (0, 0, 1) in the rod's frame, so
+  // 2 |r| sum invI_i |h_i| = 2 * 1 * 0.75 = 1.5 (the wall adds nothing), and
+  // impulse_scale = (1 + e) (speed_scale + |vn| 1.5 / K) / K = 1.5 * 5.
+  EXPECT_EQ(d[0].impulse_scale, S(7.5));
   EXPECT_EQ(j.view().j.y[0], S(3));
   EXPECT_EQ(d[1].vn, S(-1));
   EXPECT_EQ(d[1].k_n, S(1));
   EXPECT_EQ(d[1].jn, S(1.5));
-  EXPECT_EQ(d[1].speed_scale, S(10.25));
-  EXPECT_EQ(d[1].impulse_scale, S(15.375));
+  EXPECT_EQ(d[1].speed_scale, S(20.375));
+  EXPECT_EQ(d[1].impulse_scale, S(32.8125));
   EXPECT_EQ(j.view().j.y[1], S(-1.5));
   EXPECT_EQ(d[2].vn, S(0));
   EXPECT_EQ(d[2].jn, S(0));

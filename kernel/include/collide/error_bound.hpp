@@ -11,10 +11,35 @@
 // the kernel's inputs. `collide solve --check` and the tests enforce it.
 #pragma once
 
+#include <limits>
+
+#include "collide/reference.hpp"
+
 namespace collide {
 
 /// The documented bound on a kernel's impulse error, in units of
 /// eps(T) * impulse_scale (see above).
 inline constexpr double kImpulseErrorBoundEps = 64.0;
+
+/// The unit an impulse error of a kernel in precision T is measured in:
+/// eps(T) * impulse_scale, plus an underflow floor. Below the normal range
+/// values keep an absolute spacing of denorm_min(T), so a relative bound
+/// cannot hold for subnormal speeds: each of the ~10 operations that form vn
+/// may be off by denorm_min / 2, which jn = -(1 + e) vn / K carries through
+/// 1/K (with 1 + e <= 2), and J itself rounds to denorm_min.
+template <class T, class S>
+S impulse_error_unit(const ReferenceContact<S>& d) {
+  const S floor = S(std::numeric_limits<T>::denorm_min()) * (S(1) + (d.k_n > S(0) ? S(10) / d.k_n : S(0)));
+  return S(std::numeric_limits<T>::epsilon()) * d.impulse_scale + floor;
+}
+
+/// |J - J_ref| in units of impulse_error_unit<T>: the figure the bound
+/// kImpulseErrorBoundEps applies to (0 when equal, inf when the unit is 0).
+template <class T, class S>
+S normalised_impulse_error(S error, const ReferenceContact<S>& d) {
+  if (error == S(0)) return S(0);
+  const S unit = impulse_error_unit<T>(d);
+  return unit > S(0) ? error / unit : std::numeric_limits<S>::infinity();
+}
 
 }  // namespace collide
