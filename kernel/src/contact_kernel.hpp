@@ -16,9 +16,11 @@
 // page's method: h = R^T (r x d) is the lever arm seen from the body, and
 //     (r x d) . Iw^-1 (r x d) = h . (invI * h)          (component-wise product).
 // The page's H vector is h scaled by sqrt(invI * m), and its 1 + |H|^2 over m
-// is 1/m plus this term. Every term of K is a sum of non-negative products, so
-// K has no cancellation: its relative error is a few eps whatever the
-// geometry. The normal impulse that gives separation speed -e vn is
+// is 1/m plus this term. Every term of K is a sum of non-negative products;
+// the cancellation is inside h = R^T (r x d), whose components carry an
+// absolute error of about eps |r|, which a huge inverse moment (a needle) or
+// a normal nearly along r amplifies (docs/collision-law.md, "The lever
+// arms"). The normal impulse that gives separation speed -e vn is
 //     jn = -(1 + e) vn / K(n),
 // and applying P = jn n changes
 //     va += P / ma,   wa += R (invI * h_a) jn,   vb -= P / mb,   wb -= R (invI * h_b) jn.
@@ -43,10 +45,11 @@
 // with `if constexpr` inside the one kernel body below, so the operations
 // they share happen in the same order in all three.
 //
-// Precision: cancellation happens only in u (the velocity terms may be large
-// and nearly opposite). The error of jn is bounded by a few eps times
-// (1 + e) * (|va| + |wa||ra| + |vb| + |wb||rb|) / K(n), the "impulse scale"
-// that reference.hpp computes and the tests and the report measure against.
+// Precision: cancellation happens in u (the velocity terms may be large and
+// nearly opposite) and in the lever arms h. The error of J is bounded by
+// kImpulseErrorBoundEps * eps times the "impulse scale" that reference.hpp
+// computes from both (plus friction and inherited terms), the figure the
+// tests, `collide solve --check` and `collide report` measure against.
 #pragma once
 
 #include <type_traits>
