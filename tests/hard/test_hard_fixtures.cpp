@@ -12,7 +12,8 @@
 // * writes impulses within the documented bound of the long double
 //   reference of the scene as the run read it (the fixture parsed in T, as
 //   the CLI parses it, solved by reference_solve<long double>): |J - Jref|
-//   <= kImpulseErrorBoundEps * eps(T) * impulse_scale on every contact;
+//   <= kImpulseErrorBoundEps * impulse_error_unit<T> on every contact
+//   (eps(T) * impulse_scale plus the underflow floor);
 // * agrees with the committed expected_impulses.csv within that same bound
 //   (the expected files are the double reading's reference; the fixtures'
 //   numbers are float values, so a float run reads the same scene up to the
@@ -143,22 +144,23 @@ void check_fixture(const fs::path& dir) {
   ASSERT_EQ(expected.size(), n);
 
   // Impulses: finite, within the bound of this run's reference and of the
-  // committed expectation.
-  const L eps = std::numeric_limits<T>::epsilon();
+  // committed expectation. The unit is the library's: eps(T) *
+  // impulse_scale plus the underflow floor (collide/error_bound.hpp).
   L worst = 0, worst_expected = 0, input_rounding = 0;
   for (std::size_t k = 0; k < n; ++k) {
     for (const L x : j[k]) ASSERT_TRUE(std::isfinite(x)) << "contact " << k;
-    const L bound = test::kErrorBoundEps * eps * in.diag[k].impulse_scale;
+    const L unit = impulse_error_unit<T>(in.diag[k]);
+    const L bound = test::kErrorBoundEps * unit;
     const L err = distance(j[k], in.ref(k));
     const L err_expected = distance(j[k], expected[k]);
     EXPECT_LE(err, bound) << "contact " << k;
     // The expectation is rounded to double: half an ulp of its own.
     EXPECT_LE(err_expected, bound + L(std::numeric_limits<double>::epsilon()) * length(expected[k]))
         << "contact " << k << " vs expected_impulses.csv";
-    if (bound > 0) {
-      worst = std::max(worst, err / (eps * in.diag[k].impulse_scale));
-      worst_expected = std::max(worst_expected, err_expected / (eps * in.diag[k].impulse_scale));
-      input_rounding = std::max(input_rounding, distance(in.ref(k), expected[k]) / (eps * in.diag[k].impulse_scale));
+    if (unit > 0) {
+      worst = std::max(worst, err / unit);
+      worst_expected = std::max(worst_expected, err_expected / unit);
+      input_rounding = std::max(input_rounding, distance(in.ref(k), expected[k]) / unit);
     }
     if constexpr (sizeof(T) == sizeof(double)) {
       // The committed expectation is today's reference, to an ulp.
@@ -167,7 +169,7 @@ void check_fixture(const fs::path& dir) {
     }
   }
   std::cout << "[fixture] " << name << " " << precision << ": max " << static_cast<double>(worst)
-            << " eps*impulse_scale vs its reference, " << static_cast<double>(worst_expected)
+            << " (units of the bound) vs its reference, " << static_cast<double>(worst_expected)
             << " vs expected_impulses.csv (this run's reference vs the expected file: "
             << static_cast<double>(input_rounding) << ")" << std::endl;
 
@@ -208,7 +210,7 @@ void check_fixture(const fs::path& dir) {
     const std::array<L, 3> w{solved.column[C::wx][i], solved.column[C::wy][i], solved.column[C::wz][i]};
     const std::array<L, 3> v0{b0.v.x[i], b0.v.y[i], b0.v.z[i]}, w0{b0.w.x[i], b0.w.y[i], b0.w.z[i]};
     const std::array<L, 3> vr{ref.v.x[i], ref.v.y[i], ref.v.z[i]}, wr{ref.w.x[i], ref.w.y[i], ref.w.z[i]};
-    const L c = (test::kErrorBoundEps + uses[i] + 4) * eps;
+    const L c = (test::kErrorBoundEps + uses[i] + 4) * L(std::numeric_limits<T>::epsilon());
     EXPECT_LE(distance(v, vr), c * (length(v0) + length(v) + v_budget[i])) << "v of body " << i;
     EXPECT_LE(distance(w, wr), c * (length(w0) + length(w) + w_budget[i])) << "w of body " << i;
   }
