@@ -6,6 +6,8 @@
 // granularity add.
 #include "support.hpp"
 
+#include "collide/bandwidth.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <fstream>
@@ -17,56 +19,11 @@ namespace collide_bench {
 
 namespace {
 
-// "32768K" / "2M" / "1048576" -> bytes; 0 if unparsable.
-std::size_t parse_size(const std::string& text) {
-  std::size_t pos = 0;
-  unsigned long long value = 0;
-  try {
-    value = std::stoull(text, &pos);
-  } catch (...) {
-    return 0;
-  }
-  const char unit = pos < text.size() ? text[pos] : ' ';
-  if (unit == 'K' || unit == 'k') {
-    value <<= 10;
-  }
-  if (unit == 'M' || unit == 'm') {
-    value <<= 20;
-  }
-  if (unit == 'G' || unit == 'g') {
-    value <<= 30;
-  }
-  return static_cast<std::size_t>(value);
-}
-
 double g_triad[3] = {0, 0, 0};
 
 }  // namespace
 
-std::size_t llc_bytes() {
-  static const std::size_t cached = [] {
-    // The highest-level unified or data cache of cpu0.
-    std::size_t best_level = 0, best_size = 0;
-    for (int index = 0; index < 8; ++index) {
-      const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/";
-      std::ifstream level_file(dir + "level"), type_file(dir + "type"), size_file(dir + "size");
-      std::size_t level = 0;
-      std::string type, size;
-      if (!(level_file >> level) || !(type_file >> type) || !(size_file >> size)) {
-        continue;
-      }
-      if (type == "Instruction") {
-        continue;
-      }
-      if (level > best_level) {
-        best_level = level;
-        best_size = parse_size(size);
-      }
-    }
-    return best_size ? best_size : std::size_t{32} << 20;
-  }();
-  return cached;
-}
+std::size_t llc_bytes() { return collide::last_level_cache_bytes(); }
 
 double status_bytes(const char* field) {
   std::ifstream status("/proc/self/status");

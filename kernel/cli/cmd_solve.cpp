@@ -105,7 +105,6 @@ template <class T>
 CheckResult check_impulses(const ImpulseView<const T>& j, const ImpulseView<long double>& ref,
                            const std::vector<ReferenceContact<long double>>& diag) {
   using L = long double;
-  const L eps = std::numeric_limits<T>::epsilon();
   CheckResult r;
   for (std::size_t k = 0; k < j.count; ++k) {
     const L dx = L(j.j.x[k]) - ref.j.x[k];

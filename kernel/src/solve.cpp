@@ -158,8 +158,9 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
   if (paired) {
-    read_bodies<M, V, T>(bodies, a, b,
-                         [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + ia[0], la, lb); });
+    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      load_deinterleaved(field + ia[0], la, lb);
+    });
   } else {
     read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
       la = gather<V>(field, ia);
@@ -182,8 +183,9 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   const auto movable_a = a.inv_mass != V(0);
   const auto movable_b = b.inv_mass != V(0);
   if (paired && stdx::all_of(movable_a && movable_b)) {
-    write_bodies<M, V, T>(bodies, a, b,
-                          [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA { store_interleaved(la, lb, field + ia[0]); });
+    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+      store_interleaved(la, lb, field + ia[0]);
+    });
   } else {
     write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
       scatter(la, field, ia, movable_a);
@@ -237,7 +239,10 @@ struct Solver::Impl {
   tbb::task_arena* arena;
 
   explicit Impl(const SolverOptions& o)
-      : options(o), owned(std::in_place, o.threads > 0 ? o.threads : tbb::task_arena::automatic), arena(&*owned) {}
+      // int{...}: a prvalue copy, so that the static constant
+      // task_arena::automatic (which libtbb does not define) is not bound to
+      // the in_place constructor's reference: unoptimised builds failed to link.
+      : options(o), owned(std::in_place, o.threads > 0 ? o.threads : int{tbb::task_arena::automatic}), arena(&*owned) {}
   Impl(const SolverOptions& o, tbb::task_arena& borrowed) : options(o), arena(&borrowed) {}
 };
 
