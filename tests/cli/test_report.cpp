@@ -34,10 +34,15 @@
 #include <gtest/gtest.h>
 
 #include "collide/error_bound.hpp"
+#include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
+
+using collide::test::RunResult;
+using collide::test::shell_quote;
+using collide::test::slurp;
 
 // ---------------------------------------------------------------------------
 // A minimal JSON reader: objects, arrays, strings (no \u escapes beyond
@@ -159,30 +164,6 @@ class JsonParser {
 // ---------------------------------------------------------------------------
 // Running the tool.
 // ---------------------------------------------------------------------------
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (const char c : s) {
-    if (c == '\'') {
-      q += "'\\''";
-    } else {
-      q += c;
-    }
-  }
-  return q + "'";
-}
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 RunResult run(const fs::path& dir, const std::vector<std::string>& args) {
   std::string cmd = shell_quote(COLLIDE_CLI_PATH);
