@@ -10,9 +10,9 @@
 // choice costs nothing. Run: build/bench/collide_lane_layer.
 #include <benchmark/benchmark.h>
 
+#include <immintrin.h>
 #include <Eigen/Core>
 #include <experimental/simd>
-#include <immintrin.h>
 #include <random>
 #include <vector>
 

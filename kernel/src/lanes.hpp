@@ -77,7 +77,8 @@ COLLIDE_LANE_INLINE V gather(const typename V::value_type* base, const Index* id
 
 /// base[idx[l]] = v[l] for every lane l whose `write` is true.
 template <class V, class Index>
-COLLIDE_LANE_INLINE void scatter(const V& v, typename V::value_type* base, const Index* idx, const typename V::mask_type& write) {
+COLLIDE_LANE_INLINE void scatter(const V& v, typename V::value_type* base, const Index* idx,
+                                 const typename V::mask_type& write) {
   for (std::size_t l = 0; l < V::size(); ++l) {
     if (write[l]) base[idx[l]] = v[l];
   }
@@ -115,10 +116,10 @@ template <class V>
 COLLIDE_LANE_INLINE void store_interleaved(const V& even, const V& odd, typename V::value_type* p) {
 #if defined(__AVX2__)
   if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 8) {
-    const __m256 e = _mm256_castpd_ps(
-        _mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(even)), _MM_SHUFFLE(3, 1, 2, 0)));
-    const __m256 o = _mm256_castpd_ps(
-        _mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(odd)), _MM_SHUFFLE(3, 1, 2, 0)));
+    const __m256 e =
+        _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(even)), _MM_SHUFFLE(3, 1, 2, 0)));
+    const __m256 o =
+        _mm256_castpd_ps(_mm256_permute4x64_pd(_mm256_castps_pd(static_cast<__m256>(odd)), _MM_SHUFFLE(3, 1, 2, 0)));
     _mm256_storeu_ps(p, _mm256_unpacklo_ps(e, o));
     _mm256_storeu_ps(p + 8, _mm256_unpackhi_ps(e, o));
     return;

@@ -35,16 +35,14 @@ struct RefBody {
   /// rounding of the large one: with a moment ratio of 1e-12 (a needle) the
   /// formed matrix was off by ~1e-7 relative even in long double, and the
   /// reference, not the kernel, was wrong.
-  V3 inv_inertia_world(const V3& x) const {
-    return rotation * inv_inertia.cwiseProduct(rotation.transpose() * x);
-  }
+  V3 inv_inertia_world(const V3& x) const { return rotation * inv_inertia.cwiseProduct(rotation.transpose() * x); }
 
   RefBody(const BodyView<S>& bodies, std::size_t i) {
     inv_mass = bodies.inv_mass[i];
     // The law: a body with m = inf is immovable whatever its I.
     const bool immovable = inv_mass == S(0);
-    const V3 inv_i = immovable ? V3::Zero()
-                               : V3(bodies.inv_inertia.x[i], bodies.inv_inertia.y[i], bodies.inv_inertia.z[i]);
+    const V3 inv_i =
+        immovable ? V3::Zero() : V3(bodies.inv_inertia.x[i], bodies.inv_inertia.y[i], bodies.inv_inertia.z[i]);
     const Eigen::Quaternion<S> q =
         Eigen::Quaternion<S>(bodies.q.w[i], bodies.q.x[i], bodies.q.y[i], bodies.q.z[i]).normalized();
     rotation = q.toRotationMatrix();
@@ -164,10 +162,9 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
           // body with one small moment, where the plain scale was exceeded.
           // And on the sliding side jt = mu jn carries mu times the error of
           // jn (mu may exceed 1).
-          d.impulse_scale =
-              (S(1) + mu) * d.impulse_scale +
-              (d.speed_scale + speed_scale()) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
-              d.jt * lever_sensitivity(t) / d.k_t;
+          d.impulse_scale = (S(1) + mu) * d.impulse_scale +
+                            (d.speed_scale + speed_scale()) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
+                            d.jt * lever_sensitivity(t) / d.k_t;
           apply(-d.jt * t);
           j -= d.jt * t;
         }

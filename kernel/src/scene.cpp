@@ -28,8 +28,8 @@ T inverse_or_inf(T x) {
 
 template <class T>
 void BodyBuffer<T>::resize(std::size_t n) {
-  for (auto* v : {&inv_mass_, &ix_, &iy_, &iz_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_,
-                  &wz_}) {
+  for (auto* v :
+       {&inv_mass_, &ix_, &iy_, &iz_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_, &wz_}) {
     v->resize(n, T(0));
   }
   qw_.resize(n, T(1));
@@ -37,8 +37,8 @@ void BodyBuffer<T>::resize(std::size_t n) {
 
 template <class T>
 void BodyBuffer<T>::reserve(std::size_t n) {
-  for (auto* v : {&inv_mass_, &ix_, &iy_, &iz_, &qw_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_,
-                  &wy_, &wz_}) {
+  for (auto* v :
+       {&inv_mass_, &ix_, &iy_, &iz_, &qw_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_, &wz_}) {
     v->reserve(n);
   }
 }
