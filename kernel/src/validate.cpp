@@ -123,8 +123,9 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
       return fail("contacts", "b", k, contacts.b[k],
                   ("out of range (" + std::to_string(bodies.count) + " bodies)").c_str());
     }
-    if (contacts.a[k] == contacts.b[k])
+    if (contacts.a[k] == contacts.b[k]) {
       return fail("contacts", "b", k, contacts.b[k], "a contact of a body with itself");
+    }
     const std::pair<const char*, const T*> finite[] = {{"c.x", contacts.c.x}, {"c.y", contacts.c.y},
                                                        {"c.z", contacts.c.z}, {"n.x", contacts.n.x},
                                                        {"n.y", contacts.n.y}, {"n.z", contacts.n.z}};
