@@ -10,7 +10,6 @@
 //   * the written numbers read back to the values the library computes;
 //   * inf of immovable bodies and all unchanged columns survive a solve;
 //   * usage errors: exit 2.
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <charconv>
@@ -38,7 +37,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using collide::test::RunResult;
-using collide::test::shell_quote;
 using collide::test::slurp;
 
 void spit(const fs::path& path, const std::string& text) {
@@ -84,22 +82,7 @@ class CliTest : public ::testing::Test {
   fs::path path(const std::string& name) const { return dir_ / name; }
 
   RunResult run(const std::vector<std::string>& args) const {
-    std::string cmd = shell_quote(COLLIDE_CLI_PATH);
-    for (const std::string& a : args) {
-      cmd += ' ';
-      cmd += shell_quote(a);
-    }
-    const fs::path out = dir_ / "_stdout.txt";
-    const fs::path err = dir_ / "_stderr.txt";
-    cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    fs::remove(out);
-    fs::remove(err);
-    return r;
+    return collide::test::run_program(COLLIDE_CLI_PATH, dir_, args);
   }
 
   /// Writes the scene files and runs solve on them with `extra` options.

@@ -17,7 +17,6 @@
 //
 // The JSON is read with a small parser below (no JSON library is a
 // dependency of the project).
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -41,7 +40,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using collide::test::RunResult;
-using collide::test::shell_quote;
 using collide::test::slurp;
 
 // ---------------------------------------------------------------------------
@@ -166,19 +164,7 @@ class JsonParser {
 // ---------------------------------------------------------------------------
 
 RunResult run(const fs::path& dir, const std::vector<std::string>& args) {
-  std::string cmd = shell_quote(COLLIDE_CLI_PATH);
-  for (const std::string& a : args) {
-    cmd += ' ';
-    cmd += shell_quote(a);
-  }
-  const fs::path out = dir / "_stdout.txt", err = dir / "_stderr.txt";
-  cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return collide::test::run_program(COLLIDE_CLI_PATH, dir, args);
 }
 
 /// The one quick report every test reads.

@@ -1,11 +1,16 @@
-// run_cli.hpp - what the tests that run a built program share: its result,
-// shell quoting for std::system, and reading a whole file back.
+// run_cli.hpp - what the tests that run a built program share: running it
+// with its output captured, shell quoting for std::system, and reading a
+// whole file back.
 #pragma once
 
+#include <sys/wait.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace collide::test {
 
@@ -35,6 +40,28 @@ inline std::string slurp(const std::filesystem::path& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+/// Runs `program` with `args` through the shell, its stdout and stderr
+/// captured in files under `dir` (removed afterwards).
+inline RunResult run_program(const std::string& program, const std::filesystem::path& dir,
+                             const std::vector<std::string>& args) {
+  std::string cmd = shell_quote(program);
+  for (const std::string& a : args) {
+    cmd += ' ';
+    cmd += shell_quote(a);
+  }
+  const std::filesystem::path out = dir / "_stdout.txt";
+  const std::filesystem::path err = dir / "_stderr.txt";
+  cmd += " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string());
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return r;
 }
 
 }  // namespace collide::test
