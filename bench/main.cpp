@@ -9,6 +9,10 @@
 //     schedule/<scene>/<f32|f64>/n:N      Schedule::build alone
 //     solve/<scene>/<prec>/<scalar|simd>/t:{1,2}/n:N
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
+//   then the body-model grid at 64Ki and 4Mi:
+//     model/<scene>/<model>[+mu]/<prec>/simd/t:{1,2}/n:N
+//     twin/pairs/<model>[+mu]/<prec>/t:{1,2}/n:N   the model's memory-only twin
+//                                    (memory_twin.hpp): the ceiling of its layout
 // Scenes: pairs (collide::generate_pairs: contact k joins bodies 2k, 2k+1),
 // debris (collide::generate_debris: N/2 movable bodies shared at random plus
 // one immovable ground under 25% of the contacts), and pairs+mu (pairs with
@@ -89,6 +93,7 @@
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/traffic.hpp"
+#include "memory_twin.hpp"
 #include "support.hpp"
 #include "textbook.hpp"
 
@@ -294,6 +299,10 @@ std::string model_name(Kind kind, collide::Model model, bool friction, const cha
   return std::string("model/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
          precision + "/simd/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
+std::string twin_name(collide::Model model, bool friction, const char* precision, int threads, std::size_t n) {
+  return std::string("twin/pairs/") + collide::to_string(model) + (friction ? "+mu" : "") + "/" + precision +
+         "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
+}
 std::string textbook_name(Kind kind, const char* precision, std::size_t n) {
   return std::string("textbook/") + kind_name(kind) + "/" + precision + "/t:1/n:" + std::to_string(n);
 }
@@ -381,6 +390,27 @@ void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model
   state.SetLabel(std::string(collide::to_string(stats.model)) + ", " + std::to_string(stats.lanes) + " lanes");
 }
 
+/// The memory-only twin of model_row (memory_twin.hpp) on the same scene:
+/// the ceiling of the model's data layout, in the same bytes per collision.
+template <class T>
+void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads) {
+  Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  const double seconds = timed_solves(state, p, [&] { memory_twin_pass<T>(model, arena, bodies, contacts, impulses); });
+
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(model, sizeof(T), p.friction));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  set_counters(state, columns);
+  state.SetLabel("memory only");
+}
+
 template <class T>
 void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
   Prepared<T>& p = g_cache.get<T>(kind, n);
@@ -459,6 +489,13 @@ void register_models(Kind kind, std::size_t n) {
       for (const int threads : {1, 2}) {
         add_row(model_name(kind, model, friction, precision_name<T>(), threads, n),
                 [=](benchmark::State& s) { model_row<T>(s, kind, n, model, friction, threads); });
+      }
+      // The layout's ceiling, on the scene the rows above just used.
+      if (kind == Kind::pairs) {
+        for (const int threads : {1, 2}) {
+          add_row(twin_name(model, friction, precision_name<T>(), threads, n),
+                  [=](benchmark::State& s) { twin_row<T>(s, kind, n, model, friction, threads); });
+        }
       }
     }
   }
@@ -689,12 +726,36 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
       }
     }
     target(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + which + ")").c_str(), lowest, 0.60, "");
+    // Not a target: what the data layout allows (memory_twin.hpp).
+    double lowest_twin_frac = 0, lowest_of_twin = 0;
+    std::string twin_which = "n/a";
+    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+      for (const bool friction : {false, true}) {
+        const Result r = rep.get(model_name(Kind::pairs, model, friction, f32, 2, stream_n));
+        const Result twin = rep.get(twin_name(model, friction, f32, 2, stream_n));
+        if (!r.valid || !twin.valid) continue;
+        lowest_twin_frac = twin_which == "n/a" ? twin.bw_frac : std::min(lowest_twin_frac, twin.bw_frac);
+        if (twin_which == "n/a" || r.coll_per_s / twin.coll_per_s < lowest_of_twin) {
+          lowest_of_twin = r.coll_per_s / twin.coll_per_s;
+          twin_which = std::string(collide::to_string(model)) + (friction ? "+mu" : "");
+        }
+      }
+    }
+    if (twin_which != "n/a") {
+      print(
+          "  (memory-only twins of the models reach %.2f of the bound at the lowest; the models reach at least\n"
+          "   %.2f of their twin's throughput (%s): the rest of the gap is the data layout, not the arithmetic)\n",
+          lowest_twin_frac, lowest_of_twin, twin_which.c_str());
+    }
   }
 
   // The body models: million collisions per second and fraction of each
   // model's own bandwidth bound, SIMD.
-  print("\nBody models, simd [Mcoll/s at 1 / 2 threads; B/coll; bw_frac at 2 threads]\n");
-  print("  %-7s %-13s %-4s %9s  %8s %8s %6s %7s\n", "scene", "model", "prec", "N", "t:1", "t:2", "B/coll", "bw_frac");
+  print(
+      "\nBody models, simd [Mcoll/s at 1 / 2 threads; B/coll; bw_frac at 2 threads; the memory-only twin\n"
+      "  at 2 threads (pairs): Mcoll/s, its bw_frac, and the model's throughput over the twin's]\n");
+  print("  %-7s %-13s %-4s %9s  %8s %8s %6s %7s  %8s %7s %7s\n", "scene", "model", "prec", "N", "t:1", "t:2", "B/coll",
+        "bw_frac", "twin t:2", "bw_frac", "of twin");
   for (Kind kind : {Kind::pairs, Kind::debris}) {
     for (const char* precision : {"f32", "f64"}) {
       for (std::size_t n : options.sizes) {
@@ -707,8 +768,14 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
             }
             const std::size_t bytes = collide::bytes_per_collision(model, precision[1] == '3' ? 4 : 8, friction);
             const std::string label = std::string(collide::to_string(model)) + (friction ? " + mu" : "");
-            print("  %-7s %-13s %-4s %9zu  %8.1f %8.1f %6zu %7.2f\n", kind_name(kind), label.c_str(), precision, n,
+            print("  %-7s %-13s %-4s %9zu  %8.1f %8.1f %6zu %7.2f", kind_name(kind), label.c_str(), precision, n,
                   t1.coll_per_s / 1e6, t2.coll_per_s / 1e6, bytes, t2.bw_frac);
+            const Result twin = rep.get(twin_name(model, friction, precision, 2, n));
+            if (kind == Kind::pairs && twin.valid && t2.valid) {
+              print("  %8.1f %7.2f %7.2f\n", twin.coll_per_s / 1e6, twin.bw_frac, t2.coll_per_s / twin.coll_per_s);
+            } else {
+              print("\n");
+            }
           }
         }
       }
