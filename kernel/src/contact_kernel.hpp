@@ -254,8 +254,7 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
       // Slides when ut is nonzero and every component finite (scaled, they
       // are at most 2^40); a NaN or inf component never slides. |ut| itself
       // may still overflow to inf, and then jt = mu jn.
-      const auto sliding =
-          may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
+      const auto sliding = may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
       const Vec3<V> t = slide.unit * (V(1) / select(sliding, slide.scaled_length, V(1)));
       const LeverArm<V> tarm_a = lever_arm(a, ra, t);
       const LeverArm<V> tarm_b = lever_arm(b, rb, t);

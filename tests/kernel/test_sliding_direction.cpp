@@ -41,9 +41,8 @@ Direction<typename V::value_type> direction_in(const typename V::value_type (&ut
   using T = typename V::value_type;
   const d::Vec3<V> u{V(ut[0]), V(ut[1]), V(ut[2])};
   const d::SlidingDirection<V> s = d::sliding_direction(u);
-  return Direction<T>{{T(s.unit.x[lane]), T(s.unit.y[lane]), T(s.unit.z[lane])},
-                      T(s.scaled_length[lane]),
-                      T(s.speed[lane])};
+  return Direction<T>{
+      {T(s.unit.x[lane]), T(s.unit.y[lane]), T(s.unit.z[lane])}, T(s.scaled_length[lane]), T(s.speed[lane])};
 }
 
 template <class T>
@@ -82,7 +81,7 @@ void expect_accurate_over_the_whole_range() {
   using L = long double;
   const T eps = std::numeric_limits<T>::epsilon();
   const int lo = std::numeric_limits<T>::min_exponent - std::numeric_limits<T>::digits;  // smallest subnormal
-  const int hi = std::numeric_limits<T>::max_exponent - 2;  // |ut| stays finite
+  const int hi = std::numeric_limits<T>::max_exponent - 2;                               // |ut| stays finite
   std::mt19937_64 rng(11);
   for (int e = lo + 2; e <= hi; ++e) {
     for (int trial = 0; trial < 4; ++trial) {
