@@ -11,8 +11,11 @@
 // reach. The twin measures that directly: the same arrays, visited in the
 // same blocks and groups as the SIMD kernel visits them (one group = one
 // vector of contacts, their 2W bodies; blocks of 1024 contacts over TBB,
-// like collide::Solver), each value read once and the written arrays
-// written once, with one add per value instead of the law. What it moves
+// like collide::Solver), with the kernel's own vector loads and stores
+// (lanes.hpp) and one add per value instead of the law. Every array is
+// swept over the same range (the two index arrays through one value per
+// group: their cache lines are what costs) and the written arrays are
+// written once. What it moves
 // per collision is the model's bytes per collision (collide/traffic.hpp), so
 // kernel GB/s over twin GB/s is the fraction of the layout's own ceiling that
 // the arithmetic leaves.
