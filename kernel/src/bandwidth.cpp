@@ -1,9 +1,8 @@
 // bandwidth.cpp - the triad bandwidth and the cache sizes of bandwidth.hpp.
 //
-// bench/triad.cpp measures the same triad inside Google Benchmark (mean over
-// the benchmark's iterations); this is the library's reusable form, which the
-// report uses (best pass, see the header). The loop and the slicing are the
-// same.
+// The triad itself lives here once (TriadArrays): `collide report` takes the
+// best of its passes (measure_triad), bench/triad.cpp times its passes inside
+// Google Benchmark (mean over the iterations).
 #include "collide/bandwidth.hpp"
 
 #include <algorithm>
@@ -58,58 +57,72 @@ std::size_t last_level_cache_bytes() {
   return std::size_t{32} << 20;
 }
 
-TriadResult measure_triad(int threads, std::size_t array_bytes, int passes) {
-  threads = std::max(1, threads);
-  passes = std::max(1, passes);
-  if (array_bytes == 0) array_bytes = std::max<std::size_t>(4 * last_level_cache_bytes(), std::size_t{128} << 20);
-  const std::size_t n = array_bytes / sizeof(float);
-  // new[] without value-initialisation: the first touch below is what maps the
-  // pages, on the thread that will use them.
-  const std::unique_ptr<float[]> a(new float[n]), b(new float[n]), c(new float[n]);
-  oneapi::tbb::task_arena arena(threads);
+struct TriadArrays::Impl {
+  int threads;
+  std::size_t n;
+  // new[] without value-initialisation: the first touch in the constructor is
+  // what maps the pages, on the thread that will use them.
+  std::unique_ptr<float[]> a, b, c;
+  oneapi::tbb::task_arena arena;
+
+  Impl(int t, std::size_t count)
+      : threads(t), n(count), a(new float[count]), b(new float[count]), c(new float[count]), arena(t) {}
 
   // Runs f(begin, end) over [0, n) in `threads` contiguous slices.
-  auto for_slices = [&](auto&& f) {
+  template <class F>
+  void for_slices(F&& f) {
     arena.execute([&] {
       oneapi::tbb::parallel_for(
           oneapi::tbb::blocked_range<std::size_t>(0, n, n / static_cast<std::size_t>(threads) / 16 + 1),
           [&](const oneapi::tbb::blocked_range<std::size_t>& r) { f(r.begin(), r.end()); },
           oneapi::tbb::static_partitioner());
     });
-  };
-  for_slices([&](std::size_t begin, std::size_t end) {
-    std::fill(a.get() + begin, a.get() + end, 1.0f);
-    std::fill(b.get() + begin, b.get() + end, 2.0f);
-    std::fill(c.get() + begin, c.get() + end, 0.0f);
-  });
-  const float s = 3.0f;
-  auto triad = [&] {
-    for_slices([&](std::size_t begin, std::size_t end) {
-      const float* __restrict pa = a.get();
-      const float* __restrict pb = b.get();
-      float* __restrict pc = c.get();
-      for (std::size_t i = begin; i < end; ++i) pc[i] = pa[i] + s * pb[i];
-    });
-  };
+  }
+};
 
-  triad();  // warm-up: threads started, pages mapped, nothing left to fault
+TriadArrays::TriadArrays(int threads, std::size_t array_bytes) {
+  threads = std::max(1, threads);
+  if (array_bytes == 0) array_bytes = std::max<std::size_t>(4 * last_level_cache_bytes(), std::size_t{128} << 20);
+  impl_ = std::make_unique<Impl>(threads, array_bytes / sizeof(float));
+  impl_->for_slices([&](std::size_t begin, std::size_t end) {
+    std::fill(impl_->a.get() + begin, impl_->a.get() + end, 1.0f);
+    std::fill(impl_->b.get() + begin, impl_->b.get() + end, 2.0f);
+    std::fill(impl_->c.get() + begin, impl_->c.get() + end, 0.0f);
+  });
+  pass();  // warm-up: threads started, pages mapped, nothing left to fault
+}
+
+TriadArrays::~TriadArrays() = default;
+
+void TriadArrays::pass() {
+  const float s = 3.0f;
+  Impl& m = *impl_;
+  m.for_slices([&](std::size_t begin, std::size_t end) {
+    const float* __restrict pa = m.a.get();
+    const float* __restrict pb = m.b.get();
+    float* __restrict pc = m.c.get();
+    for (std::size_t i = begin; i < end; ++i) pc[i] = pa[i] + s * pb[i];
+  });
+}
+
+std::size_t TriadArrays::elements() const { return impl_->n; }
+int TriadArrays::threads() const { return impl_->threads; }
+
+TriadResult measure_triad(int threads, std::size_t array_bytes, int passes) {
+  passes = std::max(1, passes);
+  TriadArrays triad(threads, array_bytes);
   std::vector<double> seconds;
   for (int p = 0; p < passes; ++p) {
     const auto t0 = std::chrono::steady_clock::now();
-    triad();
+    triad.pass();
     seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
-  // The result is read so the stores cannot be dropped.
-  volatile float sink = c[n / 2];
-  (void)sink;
-
   std::sort(seconds.begin(), seconds.end());
-  const double bytes = 12.0 * static_cast<double>(n);
   TriadResult r;
-  r.bytes_per_second = bytes / seconds.front();
-  r.median_bytes_per_second = bytes / seconds[seconds.size() / 2];
-  r.array_bytes = n * sizeof(float);
-  r.threads = threads;
+  r.bytes_per_second = triad.bytes_per_pass() / seconds.front();
+  r.median_bytes_per_second = triad.bytes_per_pass() / seconds[seconds.size() / 2];
+  r.array_bytes = triad.elements() * sizeof(float);
+  r.threads = triad.threads();
   r.passes = passes;
   return r;
 }

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 
 namespace collide {
 
@@ -39,6 +40,32 @@ struct TriadResult {
   std::size_t array_bytes = 0;         ///< bytes of each of the three arrays
   int threads = 1;
   int passes = 0;  ///< timed passes
+};
+
+/// The triad's three arrays and its threads, for a caller that times the
+/// passes itself (collide_bench does, inside Google Benchmark); measure_triad
+/// below is built on it. Construction allocates the arrays, first-touches
+/// them with the threads' slicing and runs one untimed warm-up pass.
+class TriadArrays {
+ public:
+  /// `threads` >= 1 (smaller is taken as 1); `array_bytes` 0 means
+  /// max(4 x last-level cache, 128 MiB).
+  explicit TriadArrays(int threads, std::size_t array_bytes = 0);
+  ~TriadArrays();
+  TriadArrays(const TriadArrays&) = delete;
+  TriadArrays& operator=(const TriadArrays&) = delete;
+
+  /// One pass of c[i] = a[i] + s * b[i] over every element.
+  void pass();
+  /// Elements per array.
+  [[nodiscard]] std::size_t elements() const;
+  /// Bytes one pass counts: 12 per element.
+  [[nodiscard]] double bytes_per_pass() const { return 12.0 * static_cast<double>(elements()); }
+  [[nodiscard]] int threads() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 /// Measures the triad with `threads` threads (>= 1). `array_bytes` 0 means
