@@ -16,13 +16,13 @@
 //   "does not slide"), and a zero ut a zero length.
 // * The scalar and SIMD lanes give the same bits for each lane.
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "contact_kernel.hpp"
+#include "support/solve_helpers.hpp"
 
 namespace collide::test {
 namespace {
@@ -43,11 +43,6 @@ Direction<typename V::value_type> direction_in(const typename V::value_type (&ut
   const d::SlidingDirection<V> s = d::sliding_direction(u);
   return Direction<T>{
       {T(s.unit.x[lane]), T(s.unit.y[lane]), T(s.unit.z[lane])}, T(s.scaled_length[lane]), T(s.speed[lane])};
-}
-
-template <class T>
-bool same_bits(T a, T b) {
-  return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
 template <class T>
