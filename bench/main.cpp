@@ -714,47 +714,46 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     const Result rigid = rep.get(model_name(Kind::pairs, Model::rigid, false, f32, 2, stream_n));
     target("pairs f32 t:2 n:4Mi, particle / rigid throughput (no friction)",
            particle.valid && rigid.valid ? particle.coll_per_s / rigid.coll_per_s : 0, 2.0, "x");
-    double lowest = 0;
-    std::string which = "n/a";
-    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
-      for (const bool friction : {false, true}) {
-        const Result r = rep.get(model_name(Kind::pairs, model, friction, f32, 2, stream_n));
-        if (r.valid && (which == "n/a" || r.bw_frac < lowest)) {
-          lowest = r.bw_frac;
-          which = std::string(collide::to_string(model)) + (friction ? "+mu" : "");
+    // The lowest and highest of a figure over the models, with their names.
+    struct Range {
+      double low = 0, high = 0;
+      std::string low_name = "n/a", high_name = "n/a";
+      bool any = false;
+      void add(double x, const std::string& name) {
+        if (!any || x < low) {
+          low = x;
+          low_name = name;
         }
-      }
-    }
-    target(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + which + ")").c_str(), lowest, 0.60, "");
-    // Not a target: what the data layout allows (memory_twin.hpp).
-    double twin_low = 0, twin_high = 0, of_low = 0, of_high = 0;
-    std::string low_which, high_which;
-    bool any = false;
-    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
-      for (const bool friction : {false, true}) {
-        const Result r = rep.get(model_name(Kind::pairs, model, friction, f32, 2, stream_n));
-        const Result twin = rep.get(twin_name(model, friction, f32, 2, stream_n));
-        if (!r.valid || !twin.valid) continue;
-        const double of_twin = r.coll_per_s / twin.coll_per_s;
-        const std::string name = std::string(collide::to_string(model)) + (friction ? "+mu" : "");
-        twin_low = any ? std::min(twin_low, twin.bw_frac) : twin.bw_frac;
-        twin_high = any ? std::max(twin_high, twin.bw_frac) : twin.bw_frac;
-        if (!any || of_twin < of_low) {
-          of_low = of_twin;
-          low_which = name;
-        }
-        if (!any || of_twin > of_high) {
-          of_high = of_twin;
-          high_which = name;
+        if (!any || x > high) {
+          high = x;
+          high_name = name;
         }
         any = true;
       }
+    };
+    Range bound_frac, twin_frac, of_twin;
+    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+      for (const bool friction : {false, true}) {
+        const std::string name = std::string(collide::to_string(model)) + (friction ? "+mu" : "");
+        const Result r = rep.get(model_name(Kind::pairs, model, friction, f32, 2, stream_n));
+        if (!r.valid) continue;
+        bound_frac.add(r.bw_frac, name);
+        const Result twin = rep.get(twin_name(model, friction, f32, 2, stream_n));
+        if (twin.valid) {
+          twin_frac.add(twin.bw_frac, name);
+          of_twin.add(r.coll_per_s / twin.coll_per_s, name);
+        }
+      }
     }
-    if (any) {
+    target(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + bound_frac.low_name + ")").c_str(),
+           bound_frac.low, 0.60, "");
+    // Not a target: what the data layout allows (memory_twin.hpp).
+    if (of_twin.any) {
       print(
           "  (not a target: the models' memory-only twins reach %.2f to %.2f of the bound, and the models\n"
           "   reach %.2f (%s) to %.2f (%s) of their twin's throughput)\n",
-          twin_low, twin_high, of_low, low_which.c_str(), of_high, high_which.c_str());
+          twin_frac.low, twin_frac.high, of_twin.low, of_twin.low_name.c_str(), of_twin.high,
+          of_twin.high_name.c_str());
     }
   }
 
