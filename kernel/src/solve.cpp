@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include <oneapi/tbb/blocked_range.h>
@@ -235,6 +236,7 @@ void solve_range_any(bool friction, const ViewOfT<M, T>& bodies, const ContactVi
 
 struct Solver::Impl {
   SolverOptions options;
+  Isa isa;  // options.isa resolved
   std::optional<tbb::task_arena> owned;  // empty when the caller's arena is borrowed
   tbb::task_arena* arena;
 
@@ -242,12 +244,24 @@ struct Solver::Impl {
       // int{...}: a prvalue copy, so that the static constant
       // task_arena::automatic (which libtbb does not define) is not bound to
       // the in_place constructor's reference: unoptimised builds failed to link.
-      : options(o), owned(std::in_place, o.threads > 0 ? o.threads : int{tbb::task_arena::automatic}), arena(&*owned) {}
-  Impl(const SolverOptions& o, tbb::task_arena& borrowed) : options(o), arena(&borrowed) {}
+      : options(o),
+        isa(resolve_isa(o.isa)),
+        owned(std::in_place, o.threads > 0 ? o.threads : int{tbb::task_arena::automatic}),
+        arena(&*owned) {}
+  Impl(const SolverOptions& o, tbb::task_arena& borrowed) : options(o), isa(resolve_isa(o.isa)), arena(&borrowed) {}
 };
+
+namespace {
+void check_options(const SolverOptions& options) {
+  if (options.accuracy == Accuracy::accurate) {
+    throw std::invalid_argument("collide::Solver: accuracy=accurate is not available yet");
+  }
+}
+}  // namespace
 
 Solver::Solver(const SolverOptions& options) {
   if (options.threads < 0) throw std::invalid_argument("collide::Solver: threads must be >= 0");
+  check_options(options);
   impl_ = std::make_unique<Impl>(options);
   impl_->arena->initialize();
 }
@@ -255,6 +269,7 @@ Solver::Solver(const ExternalArena& arena, const SolverOptions& options) {
   if (options.threads != 0) {
     throw std::invalid_argument("collide::Solver: threads must be 0 in a caller's arena (the arena decides)");
   }
+  check_options(options);
   impl_ = std::make_unique<Impl>(options, arena.arena);
   impl_->arena->initialize();  // no-op for an arena the caller already initialised
 }
@@ -332,6 +347,14 @@ SolveStats run_schedule(const SolverOptions& opt, tbb::task_arena& arena, const 
   stats.model = model_of<M>();
   stats.path = opt.path;
   stats.friction = friction;
+#if defined(__AVX512F__)
+  stats.isa = Isa::avx512;
+#elif defined(__AVX2__)
+  stats.isa = Isa::avx2;
+#else
+  stats.isa = Isa::sse2;
+#endif
+  stats.accuracy = opt.accuracy;
   return stats;
 }
 
@@ -387,7 +410,27 @@ std::size_t simd_width() {
   return detail::SimdLanes<T>::size();
 }
 
+template <class T>
+std::size_t simd_width(Isa isa) {
+  switch (resolve_isa(isa)) {
+    case Isa::avx512:
+      return 64 / sizeof(T);
+    case Isa::avx2:
+      return 32 / sizeof(T);
+    default:
+      return 16 / sizeof(T);
+  }
+}
+
 const char* to_string(Path path) { return path == Path::simd ? "simd" : "scalar"; }
+
+const char* to_string(Accuracy accuracy) { return accuracy == Accuracy::accurate ? "accurate" : "fast"; }
+
+Accuracy parse_accuracy(std::string_view name) {
+  if (name == "fast") return Accuracy::fast;
+  if (name == "accurate") return Accuracy::accurate;
+  throw std::invalid_argument("unknown accuracy '" + std::string(name) + "' (expected fast or accurate)");
+}
 
 #define COLLIDE_INSTANTIATE(T)                                                                                  \
   template SolveStats Solver::solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
@@ -400,7 +443,8 @@ const char* to_string(Path path) { return path == Path::simd ? "simd" : "scalar"
                                        const Schedule&) const;                                                  \
   template SolveStats solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,                \
                                const SolverOptions&);                                                           \
-  template std::size_t simd_width<T>();
+  template std::size_t simd_width<T>();                                                                         \
+  template std::size_t simd_width<T>(Isa);
 COLLIDE_INSTANTIATE(float)
 COLLIDE_INSTANTIATE(double)
 #undef COLLIDE_INSTANTIATE

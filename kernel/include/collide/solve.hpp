@@ -13,6 +13,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"
 
@@ -26,6 +27,20 @@ enum class Path {
 
 const char* to_string(Path path);
 
+/// How the law's cancellation-prone quantities are evaluated. Both modes
+/// compute the same law on the same paths, ISAs and thread counts, and each
+/// is bitwise identical across them; they differ from each other in the last
+/// bits (docs/collision-law.md, "Accuracy modes").
+enum class Accuracy {
+  fast,      ///< plain IEEE arithmetic in the working precision
+  accurate,  ///< the relative velocity, the lever arms and friction's u' free of cancellation
+};
+
+/// "fast" or "accurate".
+const char* to_string(Accuracy accuracy);
+/// Parses the names of to_string(); throws std::invalid_argument otherwise.
+Accuracy parse_accuracy(std::string_view name);
+
 struct SolverOptions {
   Path path = Path::simd;
   /// Worker threads; 0 means every hardware thread. Results do not depend on
@@ -37,6 +52,11 @@ struct SolverOptions {
   /// and lets the small batches of shared-body scenes (the debris scene's
   /// batches are a few thousand contacts at 64k) still split across threads.
   std::size_t block = 1024;
+  /// Instruction set of the SIMD path (collide/isa.hpp): automatic is
+  /// COLLIDE_ISA, else the best the CPU has. Resolved when the Solver is
+  /// built; one the CPU lacks makes the constructor throw.
+  Isa isa = Isa::automatic;
+  Accuracy accuracy = Accuracy::fast;
 };
 
 /// What a solve did.
@@ -50,9 +70,11 @@ struct SolveStats {
   Model model = Model::rigid;
   Path path = Path::simd;
   bool friction = false;  ///< the Coulomb step ran (ContactView::mu was set)
+  Isa isa = Isa::sse2;    ///< the instruction set that ran (never automatic)
+  Accuracy accuracy = Accuracy::fast;
 };
 
-/// Number of lanes of the SIMD path for T in this build.
+/// Number of lanes of the SIMD path for T under default_isa().
 template <class T>
 std::size_t simd_width();
 
