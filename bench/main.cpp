@@ -294,6 +294,11 @@ std::string solve_name(Kind kind, const char* precision, Path path, int threads,
   return std::string("solve/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(path) +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
+/// The SIMD path of one instruction set (issue 12: every ISA the CPU has).
+std::string isa_name(Kind kind, const char* precision, collide::Isa isa, int threads, std::size_t n) {
+  return std::string("isa/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(isa) +
+         "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
+}
 std::string model_name(Kind kind, collide::Model model, bool friction, const char* precision, int threads,
                        std::size_t n) {
   return std::string("model/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
@@ -334,11 +339,13 @@ double timed_solves(benchmark::State& state, Prepared<T>& p, F&& solve_once) {
 }
 
 template <class T>
-void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int threads) {
+void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int threads,
+               collide::Isa isa = collide::Isa::automatic) {
   Prepared<T>& p = g_cache.get<T>(kind, n);
   collide::SolverOptions options;
   options.path = path;
   options.threads = threads;
+  options.isa = isa;
   const collide::Solver solver(options);
   const collide::BodyView<T> bodies = p.bodies();
   const collide::ContactView<T> contacts = p.contacts();
@@ -354,7 +361,8 @@ void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(std::to_string(stats.lanes) + " lanes");
+  state.SetLabel(std::string(path == Path::simd ? collide::to_string(stats.isa) : "scalar") + ", " +
+                 std::to_string(stats.lanes) + " lanes");
 }
 
 /// One body model on a scene whose bodies fit it (GenerateOptions::model),
@@ -470,6 +478,16 @@ void register_group(Kind kind, std::size_t n) {
     for (int threads : {1, 2}) {
       add_row(solve_name(kind, precision, path, threads, n),
               [=](benchmark::State& s) { solve_row<T>(s, kind, n, path, threads); });
+    }
+  }
+  // The SIMD path of every ISA this CPU has (the rows above run the default,
+  // the best one), in cache on 1 thread and streaming on 2.
+  if (kind != Kind::pairs_mu && (n == 65536 || n == 4194304)) {
+    for (const collide::Isa isa : {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512}) {
+      if (!collide::isa_supported(isa)) continue;
+      const int threads = n == 65536 ? 1 : 2;
+      add_row(isa_name(kind, precision, isa, threads, n),
+              [=](benchmark::State& s) { solve_row<T>(s, kind, n, Path::simd, threads, isa); });
     }
   }
   // The baseline up to 4Mi: beyond, it is as memory-bound as at 4Mi and costs
@@ -673,6 +691,8 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
         std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20) >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
+  print("SIMD rows run %s (the best of this CPU: %s; isa/ rows run each ISA it has)\n",
+        collide::to_string(collide::default_isa()), collide::to_string(collide::best_isa()));
   if (!checks_ok) {
     print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
   }
@@ -700,6 +720,27 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     const Result t1 = rep.get(solve_name(Kind::pairs, f32, Path::simd, 1, cache_n));
     target("pairs f32 simd n:64Ki (in LLC), 2 threads / 1 thread",
            t1.valid && t2.valid ? t2.coll_per_s / t1.coll_per_s : 0, 1.8, "x");
+  }
+  {
+    // Issue 12: the widest ISA against AVX2, in cache and streaming.
+    using collide::Isa;
+    auto ratio = [&](Kind kind, Isa a, Isa b, int threads, std::size_t n) {
+      const Result ra = rep.get(isa_name(kind, f32, a, threads, n));
+      const Result rb = rep.get(isa_name(kind, f32, b, threads, n));
+      return ra.valid && rb.valid ? ra.coll_per_s / rb.coll_per_s : 0.0;
+    };
+    if (collide::isa_supported(Isa::avx512)) {
+      target("pairs f32 t:1 n:64Ki, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 1, cache_n), 1.5, "x");
+      const Result wide = rep.get(isa_name(Kind::pairs, f32, Isa::avx512, 1, cache_n));
+      const Result scalar = rep.get(solve_name(Kind::pairs, f32, Path::scalar, 1, cache_n));
+      target("pairs f32 t:1 n:64Ki, avx512 / scalar",
+             wide.valid && scalar.valid ? wide.coll_per_s / scalar.coll_per_s : 0, 7.0, "x");
+      target("pairs f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 2, stream_n), 1.0, "x");
+      target("debris f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::debris, Isa::avx512, Isa::avx2, 2, stream_n), 1.0, "x");
+    }
+    if (collide::isa_supported(Isa::avx2)) {
+      target("pairs f32 t:1 n:64Ki, avx2 / sse2", ratio(Kind::pairs, Isa::avx2, Isa::sse2, 1, cache_n), 1.0, "x");
+    }
   }
   {
     const Result d = rep.get(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));

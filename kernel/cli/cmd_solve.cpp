@@ -44,6 +44,7 @@ namespace collide::cli {
 const char* const kSolveUsage =
     "usage: collide solve --bodies B.csv --contacts C.csv --out-bodies OB.csv --out-impulses OJ.csv\n"
     "                     [--precision float|double] [--threads N] [--path simd|scalar]\n"
+    "                     [--isa auto|sse2|avx2|avx512]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
@@ -58,6 +59,9 @@ const char* const kSolveUsage =
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
     "  --path P              simd (default) or scalar; results do not depend on it\n"
+    "  --isa I               instruction set of the simd path: auto (default: $COLLIDE_ISA,\n"
+    "                        else the best this CPU has), sse2, avx2 or avx512;\n"
+    "                        results do not depend on it\n"
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
@@ -87,6 +91,7 @@ struct SolveRequest {
   bool want_float = false;
   int threads = 0;
   Path path = Path::simd;
+  Isa isa = Isa::automatic;  // resolved in run_solve: never automatic when solving
   bool auto_model = true;
   Model model = Model::rigid;
   bool stats = false;
@@ -156,6 +161,7 @@ int solve_scene(const SolveRequest& req) {
   SolverOptions options;
   options.path = req.path;
   options.threads = req.threads;
+  options.isa = req.isa;
   const Solver solver(options);
   ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
@@ -203,6 +209,7 @@ int solve_scene(const SolveRequest& req) {
     s += ", \"threads\": " + std::to_string(stats.threads);
     s += std::string(", \"model\": \"") + to_string(stats.model) + "\"";
     s += std::string(", \"path\": \"") + to_string(stats.path) + "\"";
+    s += std::string(", \"isa\": \"") + to_string(stats.isa) + "\"";
     s += ", \"lanes\": " + std::to_string(stats.lanes);
     s += ", \"batches\": " + std::to_string(stats.batches);
     s += ", \"largest_batch\": " + std::to_string(schedule.largest_batch());
@@ -242,6 +249,7 @@ int run_solve(int argc, char** argv) {
                                      {"precision", true},
                                      {"threads", true},
                                      {"path", true},
+                                     {"isa", true},
                                      {"model", true},
                                      {"stats", false},
                                      {"check", false}});
@@ -279,6 +287,16 @@ int run_solve(int argc, char** argv) {
       throw UsageError("--path must be simd or scalar, got '" + it->second + "'");
     }
     req.path = it->second == "simd" ? Path::simd : Path::scalar;
+  }
+  {
+    // Resolved before anything is read: an unknown name, or an ISA this CPU
+    // lacks (named by --isa or by COLLIDE_ISA), is a usage error.
+    const auto it = opt.find("isa");
+    try {
+      req.isa = resolve_isa(it == opt.end() ? Isa::automatic : parse_isa(it->second));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string(it == opt.end() ? "" : "--isa: ") + e.what());
+    }
   }
   if (const auto it = opt.find("model"); it != opt.end()) {
     const std::string& m = it->second;

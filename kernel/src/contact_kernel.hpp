@@ -59,6 +59,7 @@
 #include "lanes.hpp"
 
 namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
 
 struct ParticleModel {};
 struct SphereModel {};
@@ -267,4 +268,5 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
   return result;
 }
 
+}  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

@@ -6,7 +6,8 @@
 // holds W values of float or double. Two lane types exist:
 //   * ScalarLanes<T>: std::experimental::simd with the scalar ABI, W = 1;
 //   * SimdLanes<T>:   std::experimental::simd with the native ABI of the
-//     build (AVX2: 8 float / 4 double; SSE2: 4 / 2).
+//     ISA the file is compiled for (SSE2: 4 float / 2 double; AVX2: 8 / 4;
+//     AVX-512: 16 / 8).
 // Both are the same class template, so one kernel body instantiates for both
 // with no second copy of the math. std::experimental::simd (GCC's libstdc++,
 // Parallelism TS 2) was chosen over hand-written intrinsics and over Eigen
@@ -30,8 +31,18 @@
 #include <cstdint>
 #include <experimental/simd>
 #include <type_traits>
-#if defined(__AVX2__)
+#if defined(__AVX2__) || defined(__AVX512F__)
 #include <immintrin.h>
+#endif
+
+// The inline namespace every kernel template lives in: the ISA the including
+// file is compiled for (kernel_isa.cpp is compiled once per ISA with
+// COLLIDE_KERNEL_NS=sse2, avx2, avx512; see CMakeLists.txt). Templates of one
+// ISA thus never share a mangled name with those of another, and the linker
+// cannot hand a narrower path a copy compiled for a wider ISA. Code that is not
+// a per-ISA kernel (tests, benchmarks) gets `host`, its own target's lanes.
+#ifndef COLLIDE_KERNEL_NS
+#define COLLIDE_KERNEL_NS host
 #endif
 
 // Everything a kernel body calls is forced inline: GCC's heuristics give up
@@ -42,6 +53,7 @@
 #define COLLIDE_LANE_LAMBDA __attribute__((always_inline))
 
 namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
 
 namespace stdx = std::experimental;
 
@@ -89,6 +101,27 @@ COLLIDE_LANE_INLINE void scatter(const V& v, typename V::value_type* base, const
 /// contacts laid out as pairs (2k, 2k+1), loaded with two vector loads.
 template <class V>
 COLLIDE_LANE_INLINE void load_deinterleaved(const typename V::value_type* p, V& even, V& odd) {
+#if defined(__AVX512F__)
+  // One two-source permute per output: lane l takes element 2l (or 2l + 1)
+  // of the 2W values in lo:hi.
+  if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 16) {
+    const __m512 lo = _mm512_loadu_ps(p);
+    const __m512 hi = _mm512_loadu_ps(p + 16);
+    const __m512i ie = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+    const __m512i io = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+    even = V(_mm512_permutex2var_ps(lo, ie, hi));
+    odd = V(_mm512_permutex2var_ps(lo, io, hi));
+    return;
+  } else if constexpr (std::is_same_v<V, SimdLanes<double>> && V::size() == 8) {
+    const __m512d lo = _mm512_loadu_pd(p);
+    const __m512d hi = _mm512_loadu_pd(p + 8);
+    const __m512i ie = _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14);
+    const __m512i io = _mm512_setr_epi64(1, 3, 5, 7, 9, 11, 13, 15);
+    even = V(_mm512_permutex2var_pd(lo, ie, hi));
+    odd = V(_mm512_permutex2var_pd(lo, io, hi));
+    return;
+  }
+#endif
 #if defined(__AVX2__)
   if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 8) {
     const __m256 lo = _mm256_loadu_ps(p);
@@ -114,6 +147,26 @@ COLLIDE_LANE_INLINE void load_deinterleaved(const typename V::value_type* p, V& 
 /// The inverse of load_deinterleaved: p[2l] = even[l], p[2l+1] = odd[l].
 template <class V>
 COLLIDE_LANE_INLINE void store_interleaved(const V& even, const V& odd, typename V::value_type* p) {
+#if defined(__AVX512F__)
+  if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 16) {
+    const __m512 e = static_cast<__m512>(even);
+    const __m512 o = static_cast<__m512>(odd);
+    // Indices 0-15 pick from e, 16-31 from o.
+    const __m512i lo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+    const __m512i hi = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+    _mm512_storeu_ps(p, _mm512_permutex2var_ps(e, lo, o));
+    _mm512_storeu_ps(p + 16, _mm512_permutex2var_ps(e, hi, o));
+    return;
+  } else if constexpr (std::is_same_v<V, SimdLanes<double>> && V::size() == 8) {
+    const __m512d e = static_cast<__m512d>(even);
+    const __m512d o = static_cast<__m512d>(odd);
+    const __m512i lo = _mm512_setr_epi64(0, 8, 1, 9, 2, 10, 3, 11);
+    const __m512i hi = _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15);
+    _mm512_storeu_pd(p, _mm512_permutex2var_pd(e, lo, o));
+    _mm512_storeu_pd(p + 8, _mm512_permutex2var_pd(e, hi, o));
+    return;
+  }
+#endif
 #if defined(__AVX2__)
   if constexpr (std::is_same_v<V, SimdLanes<float>> && V::size() == 8) {
     const __m256 e =
@@ -213,4 +266,5 @@ COLLIDE_LANE_INLINE Vec3<V> to_body(const Mat3<V>& m, const Vec3<V>& v) {
           m.r[0][2] * v.x + m.r[1][2] * v.y + m.r[2][2] * v.z};
 }
 
+}  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

@@ -37,6 +37,7 @@
 #include "collide/solve.hpp"
 #include "lanes.hpp"
 #include "support/solve_helpers.hpp"
+#include "support/isa_test.hpp"
 
 namespace collide::test {
 namespace {

@@ -30,6 +30,7 @@
 
 #include "collide/solve.hpp"
 #include "lanes.hpp"
+#include "support/isa_test.hpp"
 #include "support/solve_helpers.hpp"
 
 namespace collide::test {
@@ -40,16 +41,19 @@ namespace d = collide::detail;
 TEST(Lanes, WidthsMatchTheInstructionSet) {
   EXPECT_EQ(d::ScalarLanes<float>::size(), 1u);
   EXPECT_EQ(d::ScalarLanes<double>::size(), 1u);
-#if defined(__AVX__)
+#if defined(__AVX512F__)
+  EXPECT_EQ(d::SimdLanes<float>::size(), 16u);
+  EXPECT_EQ(d::SimdLanes<double>::size(), 8u);
+#elif defined(__AVX__)
   EXPECT_EQ(d::SimdLanes<float>::size(), 8u);
   EXPECT_EQ(d::SimdLanes<double>::size(), 4u);
 #elif defined(__SSE2__)
   EXPECT_EQ(d::SimdLanes<float>::size(), 4u);
   EXPECT_EQ(d::SimdLanes<double>::size(), 2u);
 #endif
-  // The library was built with the same flags as this test.
-  EXPECT_EQ(simd_width<float>(), d::SimdLanes<float>::size());
-  EXPECT_EQ(simd_width<double>(), d::SimdLanes<double>::size());
+  // The library's kernel for this ISA was built with the same flags.
+  EXPECT_EQ(simd_width<float>(test_isa()), d::SimdLanes<float>::size());
+  EXPECT_EQ(simd_width<double>(test_isa()), d::SimdLanes<double>::size());
 }
 
 /// Values with distinctive bits: NaNs with payloads, -0.0, inf, subnormals.

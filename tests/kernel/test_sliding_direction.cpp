@@ -23,6 +23,7 @@
 
 #include "contact_kernel.hpp"
 #include "support/solve_helpers.hpp"
+#include "support/isa_test.hpp"
 
 namespace collide::test {
 namespace {

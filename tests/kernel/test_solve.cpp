@@ -527,8 +527,11 @@ TEST(Solver, StatsDescribeTheRun) {
     EXPECT_EQ(st.path, path);
     EXPECT_EQ(st.model, Model::rigid);
   }
-  EXPECT_EQ(simd_width<float>(), detail::SimdLanes<float>::size());
-  EXPECT_EQ(simd_width<double>(), detail::SimdLanes<double>::size());
+  // The default SIMD width is that of the ISA a default Solver runs.
+  EXPECT_EQ(simd_width<float>(), simd_width<float>(Solver().isa()));
+  EXPECT_EQ(simd_width<double>(), simd_width<double>(Solver().isa()));
+  EXPECT_EQ(simd_width<float>(Isa::sse2), 4u);
+  EXPECT_EQ(simd_width<double>(Isa::sse2), 2u);
   EXPECT_STREQ(to_string(Path::simd), "simd");
   EXPECT_STREQ(to_string(Path::scalar), "scalar");
   EXPECT_STREQ(to_string(Model::rigid), "rigid");

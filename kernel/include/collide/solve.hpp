@@ -100,6 +100,9 @@ class Solver {
   Solver& operator=(Solver&&) noexcept;
 
   [[nodiscard]] const SolverOptions& options() const;
+  /// The instruction set this solver's SIMD path runs (options().isa
+  /// resolved; never automatic).
+  [[nodiscard]] Isa isa() const;
 
   /// Resolves every contact: updates v and w of movable bodies and writes J.
   /// Preconditions (checked by validate(), asserted in debug builds): the

@@ -1,0 +1,282 @@
+// kernel_isa.cpp - the kernel for one instruction set: gathers contacts and
+// bodies into lanes, runs the kernel body of contact_kernel.hpp, scatters the
+// results. Compiled once per ISA (kernel/CMakeLists.txt) with
+// COLLIDE_KERNEL_NS naming it; kernel_table.hpp is the seam to the driver.
+//
+// Design notes
+// ------------
+// * A range is processed W contacts at a time; the last (count mod W)
+//   contacts run through the baseline object's one-lane kernel
+//   (solve_range_scalar). Same operations, same order, no FMA: the tail is
+//   bitwise what a lane would have produced, on every ISA.
+// * Contiguous batches (every scene without shared movable bodies, like the
+//   pairs scene) load contact fields as vectors; only the first index of
+//   each group is read from `order`.
+// * Immovable bodies are gathered but never written: many lanes may read the
+//   one ground body at once, none writes it.
+// * Nothing here allocates, spawns or locks: threads are the driver's
+//   (solve.cpp); this file is arithmetic and memory only.
+#include <cassert>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "contact_kernel.hpp"
+#include "kernel_table.hpp"
+
+#ifndef COLLIDE_KERNEL_NS
+#error "kernel_isa.cpp is compiled once per ISA with COLLIDE_KERNEL_NS set (kernel/CMakeLists.txt)"
+#endif
+
+namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
+namespace {
+
+/// Where the W contacts of a group come from: consecutive indices starting at
+/// `first` (contiguous batch) or the W indices at `index`.
+struct ContactGroup {
+  bool contiguous;
+  std::uint32_t first;
+  const std::uint32_t* index;
+};
+
+template <class V, class T>
+COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
+  return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
+}
+
+/// The public view each model reads.
+template <class M, class T>
+struct ViewOf;
+template <class T>
+struct ViewOf<RigidModel, T> {
+  using type = BodyView<T>;
+};
+template <class T>
+struct ViewOf<SphereModel, T> {
+  using type = SphereView<T>;
+};
+template <class T>
+struct ViewOf<ParticleModel, T> {
+  using type = ParticleView<T>;
+};
+template <class M, class T>
+using ViewOfT = typename ViewOf<M, T>::type;
+
+/// The quaternion lanes of a rigid body, turned into its rotation once read.
+template <class V>
+struct QuatLanes {
+  V w, x, y, z;
+};
+
+/// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
+/// so that the index gather and the paired load share one field list.
+template <class M, class V, class T, class F>
+COLLIDE_LANE_INLINE void read_bodies(const ViewOfT<M, T>& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
+  f(view.inv_mass, a.inv_mass, b.inv_mass);
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
+    f(view.inv_inertia.y, a.inv_inertia.y, b.inv_inertia.y);
+    f(view.inv_inertia.z, a.inv_inertia.z, b.inv_inertia.z);
+    QuatLanes<V> qa;
+    QuatLanes<V> qb;
+    f(view.q.w, qa.w, qb.w);
+    f(view.q.x, qa.x, qb.x);
+    f(view.q.y, qa.y, qb.y);
+    f(view.q.z, qa.z, qb.z);
+    a.rotation = rotation(qa.w, qa.x, qa.y, qa.z);
+    b.rotation = rotation(qb.w, qb.x, qb.y, qb.z);
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
+  }
+  if constexpr (kRotates<M>) {
+    f(view.p.x, a.p.x, b.p.x);
+    f(view.p.y, a.p.y, b.p.y);
+    f(view.p.z, a.p.z, b.p.z);
+  }
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
+}
+
+/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
+template <class M, class V, class T, class F>
+COLLIDE_LANE_INLINE void write_bodies(const ViewOfT<M, T>& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                      F&& f) {
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
+}
+
+/// The streaming-pairs layout: contact l of the group joins bodies
+/// first + 2l and first + 2l + 1, so both sides come from 2W consecutive
+/// bodies (two vector loads and a deinterleave per field, instead of 2W
+/// scalar loads). This is how a caller lays out independent pairs, and how
+/// the pairs scene is built; any other layout takes the general gather.
+template <std::size_t W>
+COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* ib) {
+  bool paired = true;
+  for (std::size_t l = 0; l < W; ++l) {
+    paired &= (ia[l] == ia[0] + 2 * l) & (ib[l] == ia[l] + 1);
+  }
+  return paired;
+}
+
+/// Resolves one group of V::size() contacts.
+template <class M, class V, bool kFriction, class T>
+COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
+                                     const ImpulseView<T>& impulses, const ContactGroup& g) {
+  constexpr std::size_t W = V::size();
+  BodyIndex ia[W];
+  BodyIndex ib[W];
+  for (std::size_t l = 0; l < W; ++l) {
+    const std::uint32_t k = g.contiguous ? g.first + static_cast<std::uint32_t>(l) : g.index[l];
+    ia[l] = contacts.a[k];
+    ib[l] = contacts.b[k];
+    assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
+  }
+  // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
+  // would gain nothing. The arithmetic is the same either way.
+  const bool paired = W > 1 && is_paired_layout<W>(ia, ib);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  if (paired) {
+    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      load_deinterleaved(field + ia[0], la, lb);
+    });
+  } else {
+    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      la = gather<V>(field, ia);
+      lb = gather<V>(field, ib);
+    });
+  }
+
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
+
+  const ContactResult<V> r = resolve_contacts<M, V, kFriction>(a, b, c);
+
+  // An immovable body is never written, not even with its own value: another
+  // thread may be reading it (the ground is in many contacts of a batch).
+  const auto movable_a = a.inv_mass != V(0);
+  const auto movable_b = b.inv_mass != V(0);
+  if (paired && stdx::all_of(movable_a && movable_b)) {
+    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+      store_interleaved(la, lb, field + ia[0]);
+    });
+  } else {
+    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+      scatter(la, field, ia, movable_a);
+      scatter(lb, field, ib, movable_b);
+    });
+  }
+  if (g.contiguous) {
+    store(r.j.x, impulses.j.x + g.first);
+    store(r.j.y, impulses.j.y + g.first);
+    store(r.j.z, impulses.j.z + g.first);
+  } else {
+    const auto all = V(0) == V(0);
+    scatter(r.j.x, impulses.j.x, g.index, all);
+    scatter(r.j.y, impulses.j.y, g.index, all);
+    scatter(r.j.z, impulses.j.z, g.index, all);
+  }
+}
+
+/// Contacts [begin, end) of the schedule's order, all inside one batch, in
+/// groups of W; returns where the groups stopped (the tail, fewer than W
+/// contacts, is the caller's).
+template <class M, class V, bool kFriction, class T>
+COLLIDE_LANE_INLINE std::size_t solve_groups(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
+                                             const ImpulseView<T>& impulses, const std::uint32_t* order,
+                                             bool contiguous, std::size_t begin, std::size_t end) {
+  constexpr std::size_t W = V::size();
+  std::size_t i = begin;
+  for (; i + W <= end; i += W) {
+    solve_group<M, V, kFriction, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+  }
+  return i;
+}
+
+/// The job's model and friction, as template arguments.
+template <class V, class T>
+std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  const auto run = [&](const auto& view, auto model, auto friction) {
+    using M = decltype(model);
+    return solve_groups<M, V, decltype(friction)::value, T>(view, job.contacts, job.impulses, job.order, contiguous,
+                                                            begin, end);
+  };
+  switch (job.model) {
+    case Model::particle:
+      return job.friction ? run(job.particle, ParticleModel{}, std::true_type{})
+                          : run(job.particle, ParticleModel{}, std::false_type{});
+    case Model::sphere:
+      return job.friction ? run(job.sphere, SphereModel{}, std::true_type{})
+                          : run(job.sphere, SphereModel{}, std::false_type{});
+    case Model::rigid:
+      break;
+  }
+  return job.friction ? run(job.rigid, RigidModel{}, std::true_type{})
+                      : run(job.rigid, RigidModel{}, std::false_type{});
+}
+
+}  // namespace
+}  // namespace COLLIDE_KERNEL_NS
+
+#define COLLIDE_CONCAT_(a, b) a##b
+#define COLLIDE_CONCAT(a, b) COLLIDE_CONCAT_(a, b)
+
+namespace {
+
+/// The SIMD entry of this ISA: full groups in its lanes, the tail in the
+/// baseline's one lane.
+template <class T>
+void solve_range_simd(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  const std::size_t tail = solve_job_groups<SimdLanes<T>, T>(job, contiguous, begin, end);
+  if (tail < end) solve_range_scalar<T>(job, contiguous, tail, end);
+}
+
+Isa this_isa() {
+#if defined(COLLIDE_KERNEL_ISA_avx512)
+  return Isa::avx512;
+#elif defined(COLLIDE_KERNEL_ISA_avx2)
+  return Isa::avx2;
+#else
+  return Isa::sse2;
+#endif
+}
+
+}  // namespace
+
+const KernelTable& COLLIDE_CONCAT(kernel_table_, COLLIDE_KERNEL_NS)() {
+  static const KernelTable table{this_isa(), SimdLanes<float>::size(), SimdLanes<double>::size(),
+                                 &solve_range_simd<float>, &solve_range_simd<double>};
+  return table;
+}
+
+#if defined(COLLIDE_KERNEL_ISA_sse2) || defined(COLLIDE_KERNEL_ISA_native)
+// The baseline object also holds the one-lane kernel.
+template <class T>
+void solve_range_scalar(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  [[maybe_unused]] const std::size_t stop = solve_job_groups<ScalarLanes<T>, T>(job, contiguous, begin, end);
+  assert(stop == end);
+}
+template void solve_range_scalar<float>(const KernelJob<float>&, bool, std::size_t, std::size_t);
+template void solve_range_scalar<double>(const KernelJob<double>&, bool, std::size_t, std::size_t);
+#endif
+
+}  // namespace collide::detail

@@ -1,0 +1,76 @@
+// kernel_table.hpp - the seam between the driver (solve.cpp, compiled for the
+// baseline) and the kernel compiled once per instruction set (kernel_isa.cpp).
+//
+// Design notes
+// ------------
+// The driver owns everything that is not arithmetic on lanes: the schedule
+// walk, TBB, the stats. It hands a kernel a KernelJob and a range of the
+// schedule's order, through a function pointer looked up once, when the
+// Solver is built (kernel_table(Isa)). The per-ISA objects contain nothing but
+// the kernel templates, in an inline namespace named for their ISA
+// (lanes.hpp), and these entry points with ISA-suffixed names: no TBB, no
+// standard-library code that is not inlined (tests/kernel/test_isa_objects
+// checks the objects), so the linker can never pick a wide-ISA copy of a
+// function for a narrow path. One indirect call per block of ~1024 contacts is
+// the whole cost of dispatch.
+//
+// The scalar path, and the last (count mod W) contacts of every SIMD range,
+// run the baseline object's one-lane kernel: the same operations in the same
+// order, so each lane and the tail agree bit for bit whatever the ISA.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/solve.hpp"
+
+namespace collide::detail {
+
+/// Everything a kernel needs besides the range: the bodies in the view of
+/// `model` (only that member is set), the contacts, where J goes, and the
+/// schedule's order.
+template <class T>
+struct KernelJob {
+  Model model = Model::rigid;
+  bool friction = false;  ///< contacts.mu is set: run the Coulomb step
+  BodyView<T> rigid;
+  SphereView<T> sphere;
+  ParticleView<T> particle;
+  ContactView<T> contacts;
+  ImpulseView<T> impulses;
+  const std::uint32_t* order = nullptr;
+};
+
+/// Resolves order[begin, end) (all inside one batch; `contiguous` when the
+/// batch's order is consecutive indices).
+template <class T>
+using RangeKernel = void (*)(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
+
+/// The SIMD kernels of one instruction set.
+struct KernelTable {
+  Isa isa = Isa::sse2;
+  std::size_t lanes_float = 0;
+  std::size_t lanes_double = 0;
+  RangeKernel<float> simd_float = nullptr;
+  RangeKernel<double> simd_double = nullptr;
+};
+
+/// The table of a concrete ISA (not automatic) that this build has.
+const KernelTable& kernel_table(Isa isa);
+
+/// The one-lane kernel (the scalar path and every SIMD tail), from the
+/// baseline object.
+template <class T>
+void solve_range_scalar(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
+
+// One per kernel object (kernel_isa.cpp defines the one of its ISA).
+const KernelTable& kernel_table_sse2();
+const KernelTable& kernel_table_avx2();
+const KernelTable& kernel_table_avx512();
+const KernelTable& kernel_table_native();
+
+}  // namespace collide::detail

@@ -1,0 +1,113 @@
+// test_cli_isa.cpp - `collide solve --isa` and COLLIDE_ISA through the real
+// CLI (issue 12): every ISA this CPU has writes the same bytes and says which
+// ran in --stats; an unknown or unsupported ISA is a usage error that writes
+// nothing.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "collide/isa.hpp"
+#include "support/run_cli.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using collide::Isa;
+using collide::test::RunResult;
+using collide::test::slurp;
+
+class CliIsaTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(COLLIDE_TEST_TMP) /
+           (std::string("isa.") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  RunResult run(const std::vector<std::string>& args) const {
+    return collide::test::run_program(COLLIDE_CLI_PATH, dir_, args);
+  }
+  /// A debris scene with friction (shared bodies, a ground body, tails).
+  void generate() const {
+    const RunResult g = run({"gen", "--debris", "3001", "--friction", "--out", dir_.string()});
+    ASSERT_EQ(g.exit_code, 0) << g.err;
+  }
+  RunResult solve(const std::string& tag, std::vector<std::string> extra) const {
+    std::vector<std::string> args = {"solve",
+                                     "--bodies",
+                                     (dir_ / "bodies.csv").string(),
+                                     "--contacts",
+                                     (dir_ / "contacts.csv").string(),
+                                     "--out-bodies",
+                                     (dir_ / ("ob-" + tag + ".csv")).string(),
+                                     "--out-impulses",
+                                     (dir_ / ("oj-" + tag + ".csv")).string(),
+                                     "--stats"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  }
+  fs::path dir_;
+};
+
+TEST_F(CliIsaTest, EveryIsaTheCpuHasWritesTheSameBytes) {
+  generate();
+  for (const char* precision : {"float", "double"}) {
+    SCOPED_TRACE(precision);
+    const RunResult base = solve("scalar", {"--path", "scalar", "--precision", precision});
+    ASSERT_EQ(base.exit_code, 0) << base.err;
+    int ran = 0;
+    for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+      if (!collide::isa_supported(isa)) continue;
+      const std::string name = collide::to_string(isa);
+      const RunResult r = solve(name, {"--isa", name, "--precision", precision, "--threads", "2"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_NE(r.err.find("\"isa\": \"" + name + "\""), std::string::npos) << r.err;
+      EXPECT_EQ(slurp(dir_ / ("ob-" + name + ".csv")), slurp(dir_ / "ob-scalar.csv")) << name;
+      EXPECT_EQ(slurp(dir_ / ("oj-" + name + ".csv")), slurp(dir_ / "oj-scalar.csv")) << name;
+      ++ran;
+    }
+    EXPECT_GE(ran, 1);
+  }
+}
+
+TEST_F(CliIsaTest, DefaultIsTheBestIsaOrTheEnvironment) {
+  generate();
+  const RunResult r = solve("auto", {});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find(std::string("\"isa\": \"") + collide::to_string(collide::best_isa()) + "\""), std::string::npos)
+      << r.err;
+  setenv("COLLIDE_ISA", "sse2", 1);
+  const RunResult e = solve("env", {});
+  unsetenv("COLLIDE_ISA");
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  EXPECT_NE(e.err.find("\"isa\": \"sse2\""), std::string::npos) << e.err;
+}
+
+TEST_F(CliIsaTest, UnknownOrUnsupportedIsaIsAUsageErrorAndWritesNothing) {
+  generate();
+  const RunResult r = solve("bad", {"--isa", "avx3"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("avx3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "ob-bad.csv"));
+  EXPECT_FALSE(fs::exists(dir_ / "oj-bad.csv"));
+
+  setenv("COLLIDE_ISA", "mmx", 1);
+  const RunResult e = solve("badenv", {});
+  unsetenv("COLLIDE_ISA");
+  EXPECT_EQ(e.exit_code, 2);
+  EXPECT_NE(e.err.find("COLLIDE_ISA"), std::string::npos) << e.err;
+  EXPECT_FALSE(fs::exists(dir_ / "ob-badenv.csv"));
+
+  for (const Isa isa : {Isa::avx2, Isa::avx512}) {
+    if (collide::isa_supported(isa)) continue;  // only a CPU without it can refuse it
+    const RunResult u = solve("unsupported", {"--isa", collide::to_string(isa)});
+    EXPECT_EQ(u.exit_code, 2);
+    EXPECT_NE(u.err.find("not supported"), std::string::npos) << u.err;
+    EXPECT_FALSE(fs::exists(dir_ / "ob-unsupported.csv"));
+  }
+}
+
+}  // namespace
