@@ -304,6 +304,21 @@ std::string model_name(Kind kind, collide::Model model, bool friction, const cha
   return std::string("model/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
          precision + "/simd/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
+/// Which body layout a layout row runs (issue 11).
+enum class LayoutRow {
+  soa,      ///< the SoA arrays in place (SolverOptions::layout = soa)
+  packed,   ///< SoA input that the solver packs, solves and writes back (layout = packed)
+  records,  ///< the caller keeps packed records across frames: no packing in the timed solve
+};
+const char* layout_row_name(LayoutRow l) {
+  return l == LayoutRow::soa ? "soa" : l == LayoutRow::packed ? "packed" : "records";
+}
+
+std::string layout_name(Kind kind, collide::Model model, bool friction, const char* precision, LayoutRow layout,
+                        int threads, std::size_t n) {
+  return std::string("layout/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
+         precision + "/" + layout_row_name(layout) + "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
+}
 std::string twin_name(collide::Model model, bool friction, const char* precision, int threads, std::size_t n) {
   return std::string("twin/pairs/") + collide::to_string(model) + (friction ? "+mu" : "") + "/" + precision +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
@@ -316,18 +331,21 @@ std::string schedule_name(Kind kind, const char* precision, std::size_t n) {
 }
 
 /// Times `solve_once` with the scene reset before each call (untimed).
-template <class T, class F>
-double timed_solves(benchmark::State& state, Prepared<T>& p, F&& solve_once) {
+template <class T, class F, class R = void (*)()>
+double timed_solves(
+    benchmark::State& state, Prepared<T>& p, F&& solve_once, R&& reset = [] {}) {
   // Warm-up, for a scene that fits in the LLC: worker threads started, code
   // and data in cache. A larger scene starts cold anyway, and one more solve
   // of it would cost seconds for a thread start-up of microseconds.
   if (!p.exceeds_llc) {
     p.reset_for_solve();
+    reset();
     solve_once();
   }
   double seconds = 0;
   for (auto _ : state) {
     p.reset_for_solve();
+    reset();
     const auto t0 = Clock::now();
     solve_once();
     const auto t1 = Clock::now();
@@ -395,7 +413,66 @@ void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(std::string(collide::to_string(stats.model)) + ", " + std::to_string(stats.lanes) + " lanes");
+  state.SetLabel(std::string(collide::to_string(stats.model)) + ", " + collide::to_string(stats.layout) + ", " +
+                 collide::to_string(stats.isa) + ", " + std::to_string(stats.lanes) + " lanes");
+}
+
+/// One model on one layout, the rigid view's arrays (SoA) or packed records.
+template <class T, class Record>
+double layout_solve(benchmark::State& state, Prepared<T>& p, const collide::Solver& solver, collide::Model model,
+                    LayoutRow layout, collide::SolveStats& stats) {
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  if (layout != LayoutRow::records) {
+    return timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
+  }
+  collide::PackedBuffer<Record> records(bodies.count);
+  const collide::PackedView<Record> view = collide::packed_view(records);
+  auto pack_all = [&] {
+    if constexpr (std::is_same_v<Record, collide::PackedRigid<T>>) {
+      collide::pack(bodies, view);
+    } else if constexpr (std::is_same_v<Record, collide::PackedSphere<T>>) {
+      collide::pack(collide::sphere_view(bodies), view);
+    } else {
+      collide::pack(collide::particle_view(bodies), view);
+    }
+  };
+  return timed_solves(
+      state, p, [&] { stats = solver.solve(view, contacts, impulses, p.schedule); }, pack_all);
+}
+
+template <class T>
+void layout_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
+                LayoutRow layout) {
+  Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
+  collide::SolverOptions options;
+  options.path = Path::simd;
+  options.threads = threads;
+  options.layout = layout == LayoutRow::soa ? collide::BodyLayout::soa : collide::BodyLayout::packed;
+  const collide::Solver solver(options);
+  collide::SolveStats stats;
+  double seconds = 0;
+  switch (model) {
+    case collide::Model::particle:
+      seconds = layout_solve<T, collide::PackedParticle<T>>(state, p, solver, model, layout, stats);
+      break;
+    case collide::Model::sphere:
+      seconds = layout_solve<T, collide::PackedSphere<T>>(state, p, solver, model, layout, stats);
+      break;
+    case collide::Model::rigid:
+      seconds = layout_solve<T, collide::PackedRigid<T>>(state, p, solver, model, layout, stats);
+      break;
+  }
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(model, sizeof(T), p.friction));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  columns.batches = static_cast<double>(stats.batches);
+  set_counters(state, columns);
+  state.SetLabel(std::string(collide::to_string(stats.model)) + ", " + collide::to_string(stats.layout) + ", " +
+                 collide::to_string(stats.isa) + ", " + std::to_string(stats.lanes) + " lanes");
 }
 
 /// The memory-only twin of model_row (memory_twin.hpp) on the same scene:
@@ -507,6 +584,13 @@ void register_models(Kind kind, std::size_t n) {
       for (const int threads : {1, 2}) {
         add_row(model_name(kind, model, friction, precision_name<T>(), threads, n),
                 [=](benchmark::State& s) { model_row<T>(s, kind, n, model, friction, threads); });
+      }
+      // Both layouts (issue 11), on the scene the rows above just used.
+      for (const LayoutRow layout : {LayoutRow::soa, LayoutRow::packed, LayoutRow::records}) {
+        for (const int threads : {1, 2}) {
+          add_row(layout_name(kind, model, friction, precision_name<T>(), layout, threads, n),
+                  [=](benchmark::State& s) { layout_row<T>(s, kind, n, model, friction, threads, layout); });
+        }
       }
       // The layout's ceiling, on the scene the rows above just used.
       if (kind == Kind::pairs) {

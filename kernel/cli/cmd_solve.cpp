@@ -44,7 +44,7 @@ namespace collide::cli {
 const char* const kSolveUsage =
     "usage: collide solve --bodies B.csv --contacts C.csv --out-bodies OB.csv --out-impulses OJ.csv\n"
     "                     [--precision float|double] [--threads N] [--path simd|scalar]\n"
-    "                     [--isa auto|sse2|avx2|avx512]\n"
+    "                     [--isa auto|sse2|avx2|avx512] [--layout auto|soa|packed]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
@@ -59,6 +59,9 @@ const char* const kSolveUsage =
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
     "  --path P              simd (default) or scalar; results do not depend on it\n"
+    "  --layout L            body layout the kernel runs on: auto (default: packed when\n"
+    "                        the contacts reach bodies at random), soa or packed;\n"
+    "                        results do not depend on it\n"
     "  --isa I               instruction set of the simd path: auto (default: $COLLIDE_ISA,\n"
     "                        else the best this CPU has), sse2, avx2 or avx512;\n"
     "                        results do not depend on it\n"
@@ -92,6 +95,7 @@ struct SolveRequest {
   int threads = 0;
   Path path = Path::simd;
   Isa isa = Isa::automatic;  // resolved in run_solve: never automatic when solving
+  BodyLayout layout = BodyLayout::automatic;
   bool auto_model = true;
   Model model = Model::rigid;
   bool stats = false;
@@ -162,6 +166,7 @@ int solve_scene(const SolveRequest& req) {
   options.path = req.path;
   options.threads = req.threads;
   options.isa = req.isa;
+  options.layout = req.layout;
   const Solver solver(options);
   ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
@@ -210,6 +215,7 @@ int solve_scene(const SolveRequest& req) {
     s += std::string(", \"model\": \"") + to_string(stats.model) + "\"";
     s += std::string(", \"path\": \"") + to_string(stats.path) + "\"";
     s += std::string(", \"isa\": \"") + to_string(stats.isa) + "\"";
+    s += std::string(", \"layout\": \"") + to_string(stats.layout) + "\"";
     s += ", \"lanes\": " + std::to_string(stats.lanes);
     s += ", \"batches\": " + std::to_string(stats.batches);
     s += ", \"largest_batch\": " + std::to_string(schedule.largest_batch());
@@ -250,6 +256,7 @@ int run_solve(int argc, char** argv) {
                                      {"threads", true},
                                      {"path", true},
                                      {"isa", true},
+                                     {"layout", true},
                                      {"model", true},
                                      {"stats", false},
                                      {"check", false}});
@@ -296,6 +303,17 @@ int run_solve(int argc, char** argv) {
       req.isa = resolve_isa(it == opt.end() ? Isa::automatic : parse_isa(it->second));
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string(it == opt.end() ? "" : "--isa: ") + e.what());
+    }
+  }
+  if (const auto it = opt.find("layout"); it != opt.end()) {
+    if (it->second == "auto") {
+      req.layout = BodyLayout::automatic;
+    } else if (it->second == "soa") {
+      req.layout = BodyLayout::soa;
+    } else if (it->second == "packed") {
+      req.layout = BodyLayout::packed;
+    } else {
+      throw UsageError("--layout must be auto, soa or packed, got '" + it->second + "'");
     }
   }
   if (const auto it = opt.find("model"); it != opt.end()) {

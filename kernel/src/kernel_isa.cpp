@@ -16,6 +16,7 @@
 //   one ground body at once, none writes it.
 // * Nothing here allocates, spawns or locks: threads are the driver's
 //   (solve.cpp); this file is arithmetic and memory only.
+#include <algorithm>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
@@ -23,6 +24,11 @@
 
 #include "contact_kernel.hpp"
 #include "kernel_table.hpp"
+#include "packed_fields.hpp"
+
+#ifndef COLLIDE_PREFETCH_AHEAD
+#define COLLIDE_PREFETCH_AHEAD 32
+#endif
 
 #ifndef COLLIDE_KERNEL_NS
 #error "kernel_isa.cpp is compiled once per ISA with COLLIDE_KERNEL_NS set (kernel/CMakeLists.txt)"
@@ -45,24 +51,6 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
-/// The public view each model reads.
-template <class M, class T>
-struct ViewOf;
-template <class T>
-struct ViewOf<RigidModel, T> {
-  using type = BodyView<T>;
-};
-template <class T>
-struct ViewOf<SphereModel, T> {
-  using type = SphereView<T>;
-};
-template <class T>
-struct ViewOf<ParticleModel, T> {
-  using type = ParticleView<T>;
-};
-template <class M, class T>
-using ViewOfT = typename ViewOf<M, T>::type;
-
 /// The quaternion lanes of a rigid body, turned into its rotation once read.
 template <class V>
 struct QuatLanes {
@@ -71,8 +59,8 @@ struct QuatLanes {
 
 /// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
 /// so that the index gather and the paired load share one field list.
-template <class M, class V, class T, class F>
-COLLIDE_LANE_INLINE void read_bodies(const ViewOfT<M, T>& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
+template <class M, class V, class View, class F>
+COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
   f(view.inv_mass, a.inv_mass, b.inv_mass);
   if constexpr (std::is_same_v<M, RigidModel>) {
     f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
@@ -105,9 +93,8 @@ COLLIDE_LANE_INLINE void read_bodies(const ViewOfT<M, T>& view, BodyLanes<M, V>&
 }
 
 /// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
-template <class M, class V, class T, class F>
-COLLIDE_LANE_INLINE void write_bodies(const ViewOfT<M, T>& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
-                                      F&& f) {
+template <class M, class V, class View, class F>
+COLLIDE_LANE_INLINE void write_bodies(const View& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b, F&& f) {
   f(view.v.x, a.v.x, b.v.x);
   f(view.v.y, a.v.y, b.v.y);
   f(view.v.z, a.v.z, b.v.z);
@@ -132,9 +119,14 @@ COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* 
   return paired;
 }
 
+/// True for the SoA views (a field is a plain array), false for the packed
+/// layout's PackedFields (a field is strided).
+template <class View>
+inline constexpr bool kSoaLayout = std::is_pointer_v<decltype(View::inv_mass)>;
+
 /// Resolves one group of V::size() contacts.
-template <class M, class V, bool kFriction, class T>
-COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
+template <class M, class V, bool kFriction, class T, class View, class Records>
+COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records, const ContactView<T>& contacts,
                                      const ImpulseView<T>& impulses, const ContactGroup& g) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
@@ -147,18 +139,30 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   }
   // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
   // would gain nothing. The arithmetic is the same either way.
-  const bool paired = W > 1 && is_paired_layout<W>(ia, ib);
+  // The packed layout has no such shortcut (its records are already
+  // contiguous per body).
+  bool paired = false;
+  if constexpr (kSoaLayout<View>) paired = W > 1 && is_paired_layout<W>(ia, ib);
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
-  if (paired) {
-    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-      load_deinterleaved(field + ia[0], la, lb);
-    });
+  if constexpr (kSoaLayout<View>) {
+    if (paired) {
+      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        load_deinterleaved(field + ia[0], la, lb);
+      });
+    }
+  }
+  if constexpr (kSoaLayout<View>) {
+    if (!paired) {
+      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        la = gather<V>(field, ia);
+        lb = gather<V>(field, ib);
+      });
+    }
   } else {
-    read_bodies<M, V, T>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-      la = gather<V>(field, ia);
-      lb = gather<V>(field, ib);
-    });
+    (void)bodies;
+    read_records<M, V>(records, ia, a);
+    read_records<M, V>(records, ib, b);
   }
 
   ContactLanes<V> c;
@@ -175,15 +179,27 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
   // thread may be reading it (the ground is in many contacts of a batch).
   const auto movable_a = a.inv_mass != V(0);
   const auto movable_b = b.inv_mass != V(0);
-  if (paired && stdx::all_of(movable_a && movable_b)) {
-    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-      store_interleaved(la, lb, field + ia[0]);
-    });
+  bool written = false;
+  if constexpr (kSoaLayout<View>) {
+    if (paired && stdx::all_of(movable_a && movable_b)) {
+      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+        store_interleaved(la, lb, field + ia[0]);
+      });
+      written = true;
+    }
+  }
+  if constexpr (kSoaLayout<View>) {
+    if (!written) {
+      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+        scatter(la, field, ia, movable_a);
+        scatter(lb, field, ib, movable_b);
+      });
+    }
   } else {
-    write_bodies<M, V, T>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-      scatter(la, field, ia, movable_a);
-      scatter(lb, field, ib, movable_b);
-    });
+    // a's records first, then b's: within a group no movable body repeats,
+    // so the order of the stores cannot matter.
+    write_records<M, V>(const_cast<Records*>(records), ia, a, movable_a);
+    write_records<M, V>(const_cast<Records*>(records), ib, b, movable_b);
   }
   if (g.contiguous) {
     store(r.j.x, impulses.j.x + g.first);
@@ -200,14 +216,40 @@ COLLIDE_LANE_INLINE void solve_group(const ViewOfT<M, T>& bodies, const ContactV
 /// Contacts [begin, end) of the schedule's order, all inside one batch, in
 /// groups of W; returns where the groups stopped (the tail, fewer than W
 /// contacts, is the caller's).
-template <class M, class V, bool kFriction, class T>
-COLLIDE_LANE_INLINE std::size_t solve_groups(const ViewOfT<M, T>& bodies, const ContactView<T>& contacts,
+///
+/// On the packed layout with contacts in random order, the records of the
+/// contacts kPrefetchAhead positions ahead are requested before each group:
+/// a record is one to three lines, so the requests are few and the misses
+/// overlap instead of waiting one after another.
+inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
+
+template <class M, class V, bool kFriction, class T, class View, class Records>
+COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* records, const ContactView<T>& contacts,
                                              const ImpulseView<T>& impulses, const std::uint32_t* order,
                                              bool contiguous, std::size_t begin, std::size_t end) {
   constexpr std::size_t W = V::size();
   std::size_t i = begin;
+  if constexpr (!kSoaLayout<View>) {
+    if (!contiguous && W > 1) {
+      const std::size_t warm = std::min(end, begin + kPrefetchAhead);
+      for (std::size_t k = begin; k < warm; ++k) {
+        prefetch_record(records, contacts.a[order[k]]);
+        prefetch_record(records, contacts.b[order[k]]);
+      }
+      for (; i + W <= end; i += W) {
+        const std::size_t ahead_end = std::min(end, i + W + kPrefetchAhead);
+        for (std::size_t k = i + kPrefetchAhead; k < ahead_end; ++k) {
+          prefetch_record(records, contacts.a[order[k]]);
+          prefetch_record(records, contacts.b[order[k]]);
+        }
+        solve_group<M, V, kFriction, T>(bodies, records, contacts, impulses,
+                                        ContactGroup{contiguous, order[i], order + i});
+      }
+      return i;
+    }
+  }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, T>(bodies, records, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
   }
   return i;
 }
@@ -217,21 +259,43 @@ template <class V, class T>
 std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
   const auto run = [&](const auto& view, auto model, auto friction) {
     using M = decltype(model);
-    return solve_groups<M, V, decltype(friction)::value, T>(view, job.contacts, job.impulses, job.order, contiguous,
-                                                            begin, end);
+    constexpr bool kFriction = decltype(friction)::value;
+    return solve_groups<M, V, kFriction, T>(view, static_cast<const char*>(nullptr), job.contacts, job.impulses,
+                                            job.order, contiguous, begin, end);
   };
+  const auto run_packed = [&](const auto& packed, auto model, auto friction) {
+    using M = decltype(model);
+    constexpr bool kFriction = decltype(friction)::value;
+    const PackedFields<std::remove_pointer_t<decltype(packed.bodies)>> fields(packed);
+    return solve_groups<M, V, kFriction, T>(fields, packed.bodies, job.contacts, job.impulses, job.order, contiguous,
+                                            begin, end);
+  };
+  const std::true_type with_friction;
+  const std::false_type without;
+  if (job.packed) {
+    switch (job.model) {
+      case Model::particle:
+        return job.friction ? run_packed(job.packed_particle, ParticleModel{}, with_friction)
+                            : run_packed(job.packed_particle, ParticleModel{}, without);
+      case Model::sphere:
+        return job.friction ? run_packed(job.packed_sphere, SphereModel{}, with_friction)
+                            : run_packed(job.packed_sphere, SphereModel{}, without);
+      case Model::rigid:
+        break;
+    }
+    return job.friction ? run_packed(job.packed_rigid, RigidModel{}, with_friction)
+                        : run_packed(job.packed_rigid, RigidModel{}, without);
+  }
   switch (job.model) {
     case Model::particle:
-      return job.friction ? run(job.particle, ParticleModel{}, std::true_type{})
-                          : run(job.particle, ParticleModel{}, std::false_type{});
+      return job.friction ? run(job.particle, ParticleModel{}, with_friction)
+                          : run(job.particle, ParticleModel{}, without);
     case Model::sphere:
-      return job.friction ? run(job.sphere, SphereModel{}, std::true_type{})
-                          : run(job.sphere, SphereModel{}, std::false_type{});
+      return job.friction ? run(job.sphere, SphereModel{}, with_friction) : run(job.sphere, SphereModel{}, without);
     case Model::rigid:
       break;
   }
-  return job.friction ? run(job.rigid, RigidModel{}, std::true_type{})
-                      : run(job.rigid, RigidModel{}, std::false_type{});
+  return job.friction ? run(job.rigid, RigidModel{}, with_friction) : run(job.rigid, RigidModel{}, without);
 }
 
 }  // namespace

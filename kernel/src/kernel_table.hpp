@@ -26,20 +26,25 @@
 #include "collide/contacts.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
+#include "collide/packed.hpp"
 #include "collide/solve.hpp"
 
 namespace collide::detail {
 
 /// Everything a kernel needs besides the range: the bodies in the view of
-/// `model` (only that member is set), the contacts, where J goes, and the
-/// schedule's order.
+/// `model` and layout (only that member is set), the contacts, where J goes,
+/// and the schedule's order.
 template <class T>
 struct KernelJob {
   Model model = Model::rigid;
   bool friction = false;  ///< contacts.mu is set: run the Coulomb step
+  bool packed = false;    ///< the bodies are in a packed_* member, not a SoA view
   BodyView<T> rigid;
   SphereView<T> sphere;
   ParticleView<T> particle;
+  PackedView<PackedRigid<T>> packed_rigid;
+  PackedView<PackedSphere<T>> packed_sphere;
+  PackedView<PackedParticle<T>> packed_particle;
   ContactView<T> contacts;
   ImpulseView<T> impulses;
   const std::uint32_t* order = nullptr;

@@ -1,0 +1,168 @@
+// packed.cpp - exact conversions between the SoA views and the packed layout
+// (collide/packed.hpp). Plain copies, one body at a time, blocks of bodies in
+// parallel: each body is read and written by one task, so the result does not
+// depend on the thread count.
+#include "collide/packed.hpp"
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
+namespace collide {
+namespace {
+
+/// Bodies per task: a few hundred KiB of records, far above TBB's task cost.
+constexpr std::size_t kGrain = 8192;
+
+void check_counts(std::size_t from, std::size_t to, const char* what) {
+  if (from != to) {
+    throw std::invalid_argument(std::string(what) + ": the views hold " + std::to_string(from) + " and " +
+                                std::to_string(to) + " bodies");
+  }
+}
+
+template <class F>
+void for_bodies(std::size_t count, F&& f) {
+  if (count <= kGrain) {
+    for (std::size_t i = 0; i < count; ++i) f(i);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+  });
+}
+
+}  // namespace
+
+template <class U>
+void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_const_t<U>>>& to) {
+  check_counts(from.count, to.count, "collide::pack");
+  for_bodies(from.count, [&](std::size_t i) {
+    auto& r = to.bodies[i];
+    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
+    r.w[0] = from.w.x[i], r.w[1] = from.w.y[i], r.w[2] = from.w.z[i];
+    r.p[0] = from.p.x[i], r.p[1] = from.p.y[i], r.p[2] = from.p.z[i];
+    r.q[0] = from.q.w[i], r.q[1] = from.q.x[i], r.q[2] = from.q.y[i], r.q[3] = from.q.z[i];
+    r.inv_mass = from.inv_mass[i];
+    r.inv_inertia[0] = from.inv_inertia.x[i], r.inv_inertia[1] = from.inv_inertia.y[i];
+    r.inv_inertia[2] = from.inv_inertia.z[i];
+  });
+}
+
+template <class U>
+void pack(const SphereView<U>& from, const PackedView<PackedSphere<std::remove_const_t<U>>>& to) {
+  check_counts(from.count, to.count, "collide::pack");
+  for_bodies(from.count, [&](std::size_t i) {
+    auto& r = to.bodies[i];
+    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
+    r.w[0] = from.w.x[i], r.w[1] = from.w.y[i], r.w[2] = from.w.z[i];
+    r.p[0] = from.p.x[i], r.p[1] = from.p.y[i], r.p[2] = from.p.z[i];
+    r.inv_mass = from.inv_mass[i];
+    r.inv_inertia = from.inv_inertia[i];
+  });
+}
+
+template <class U>
+void pack(const ParticleView<U>& from, const PackedView<PackedParticle<std::remove_const_t<U>>>& to) {
+  check_counts(from.count, to.count, "collide::pack");
+  for_bodies(from.count, [&](std::size_t i) {
+    auto& r = to.bodies[i];
+    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
+    r.inv_mass = from.inv_mass[i];
+  });
+}
+
+template <class T>
+void unpack(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
+    to.p.x[i] = r.p[0], to.p.y[i] = r.p[1], to.p.z[i] = r.p[2];
+    to.q.w[i] = r.q[0], to.q.x[i] = r.q[1], to.q.y[i] = r.q[2], to.q.z[i] = r.q[3];
+    to.inv_mass[i] = r.inv_mass;
+    to.inv_inertia.x[i] = r.inv_inertia[0], to.inv_inertia.y[i] = r.inv_inertia[1];
+    to.inv_inertia.z[i] = r.inv_inertia[2];
+  });
+}
+
+template <class T>
+void unpack(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
+    to.p.x[i] = r.p[0], to.p.y[i] = r.p[1], to.p.z[i] = r.p[2];
+    to.inv_mass[i] = r.inv_mass;
+    to.inv_inertia[i] = r.inv_inertia;
+  });
+}
+
+template <class T>
+void unpack(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    to.inv_mass[i] = r.inv_mass;
+  });
+}
+
+template <class T>
+void unpack_velocities(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack_velocities");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    if (r.inv_mass == T(0)) return;
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
+  });
+}
+
+template <class T>
+void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack_velocities");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    if (r.inv_mass == T(0)) return;
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
+  });
+}
+
+template <class T>
+void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to) {
+  check_counts(from.count, to.count, "collide::unpack_velocities");
+  for_bodies(from.count, [&](std::size_t i) {
+    const auto& r = from.bodies[i];
+    if (r.inv_mass == T(0)) return;
+    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+  });
+}
+
+#define COLLIDE_INSTANTIATE_PACK(U)                                                                     \
+  template void pack<U>(const BodyView<U>&, const PackedView<PackedRigid<std::remove_const_t<U>>>&);    \
+  template void pack<U>(const SphereView<U>&, const PackedView<PackedSphere<std::remove_const_t<U>>>&); \
+  template void pack<U>(const ParticleView<U>&, const PackedView<PackedParticle<std::remove_const_t<U>>>&);
+#define COLLIDE_INSTANTIATE_UNPACK(T)                                                           \
+  template void unpack<T>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);               \
+  template void unpack<T>(const PackedView<PackedSphere<T>>&, const SphereView<T>&);            \
+  template void unpack<T>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);        \
+  template void unpack_velocities<T>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);    \
+  template void unpack_velocities<T>(const PackedView<PackedSphere<T>>&, const SphereView<T>&); \
+  template void unpack_velocities<T>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);
+COLLIDE_INSTANTIATE_PACK(float)
+COLLIDE_INSTANTIATE_PACK(const float)
+COLLIDE_INSTANTIATE_PACK(double)
+COLLIDE_INSTANTIATE_PACK(const double)
+COLLIDE_INSTANTIATE_UNPACK(float)
+COLLIDE_INSTANTIATE_UNPACK(double)
+#undef COLLIDE_INSTANTIATE_PACK
+#undef COLLIDE_INSTANTIATE_UNPACK
+
+}  // namespace collide
