@@ -94,6 +94,7 @@
 #include "collide/solve.hpp"
 #include "collide/traffic.hpp"
 #include "memory_twin.hpp"
+#include "packed_twin.hpp"
 #include "support.hpp"
 #include "textbook.hpp"
 
@@ -500,6 +501,30 @@ void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model 
   state.SetLabel("memory only");
 }
 
+/// The packed layout's memory-only twin (packed_twin.hpp) on the scene of the
+/// layout rows: the ceiling of `layout/.../records` rows.
+template <class T>
+void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, int threads) {
+  Prepared<T>& p = g_cache.get<T>(kind, n, collide::Model::rigid, false);
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  const collide::BodyView<T> bodies = p.bodies();
+  collide::PackedBuffer<collide::PackedRigid<T>> records(bodies.count);
+  collide::pack(bodies, collide::packed_view(records));
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  packed_twin_pass<T>(arena, collide::packed_view(records), contacts, impulses, p.schedule);  // sizes its buffers
+  const double seconds = timed_solves(
+      state, p, [&] { packed_twin_pass<T>(arena, collide::packed_view(records), contacts, impulses, p.schedule); });
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(collide::Model::rigid, sizeof(T), false));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  set_counters(state, columns);
+  state.SetLabel("memory only, packed");
+}
+
 template <class T>
 void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
   Prepared<T>& p = g_cache.get<T>(kind, n);
@@ -594,6 +619,13 @@ void register_models(Kind kind, std::size_t n) {
         for (const int threads : {1, 2}) {
           add_row(layout_name(kind, model, friction, precision_name<T>(), layout, threads, n),
                   [=](benchmark::State& s) { layout_row<T>(s, kind, n, model, friction, threads, layout); });
+        }
+      }
+      if (model == collide::Model::rigid && !friction) {
+        for (const int threads : {1, 2}) {
+          add_row(std::string("twin/packed/") + kind_name(kind) + "/rigid/" + precision_name<T>() +
+                      "/t:" + std::to_string(threads) + "/n:" + std::to_string(n),
+                  [=](benchmark::State& s) { packed_twin_row<T>(s, kind, n, threads); });
         }
       }
       // The layout's ceiling, on the scene the rows above just used.
