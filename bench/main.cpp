@@ -863,6 +863,28 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     }
   }
   {
+    // Issue 11: scattered scenes on the packed layout.
+    using collide::Model;
+    auto per_s = [&](const std::string& name) {
+      const Result r = rep.get(name);
+      return r.valid ? r.coll_per_s : 0.0;
+    };
+    auto ratio = [](double a, double b) { return a > 0 && b > 0 ? a / b : 0.0; };
+    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+      const std::string m = collide::to_string(model);
+      const double records =
+          per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
+      const double pairs = per_s(model_name(Kind::pairs, model, false, f32, 2, stream_n));
+      target(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), 0.5, "");
+    }
+    const double records = per_s(layout_name(Kind::debris, Model::rigid, false, f32, LayoutRow::records, 2, stream_n));
+    const double twin = per_s(std::string("twin/packed/debris/rigid/f32/t:2/n:") + std::to_string(stream_n));
+    target("debris rigid f32 t:2 n:4Mi, packed records / its memory-only twin", ratio(records, twin), 0.7, "");
+    const double simd = per_s(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));
+    const double scalar = per_s(solve_name(Kind::debris, f32, Path::scalar, 2, stream_n));
+    target("debris f32 t:2 n:4Mi (SoA input, automatic layout), simd / scalar", ratio(simd, scalar), 3.0, "x");
+  }
+  {
     const Result d = rep.get(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));
     const Result p = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, stream_n));
     target("f32 simd t:2 n:4Mi, debris / pairs throughput", d.valid && p.valid ? d.coll_per_s / p.coll_per_s : 0, 0.40,
