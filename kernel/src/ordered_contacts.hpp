@@ -73,6 +73,10 @@ class OrderedContacts {
   /// 0, 1, ..., n - 1: the schedule order of the ordered copy.
   const std::uint32_t* identity(std::size_t n) {
     std::uint32_t* id = identity_.reserve(n);
+    // A larger n moves the indices to fresh, uninitialised storage: the
+    // entries written before are gone, so fill from 0 again.
+    if (id != identity_data_) identity_size_ = 0;
+    identity_data_ = id;
     if (identity_size_ < n) {
       for (std::size_t p = identity_size_; p < n; ++p) id[p] = static_cast<std::uint32_t>(p);
       identity_size_ = n;
@@ -92,6 +96,7 @@ class OrderedContacts {
   ScratchRecords<T> values_[8];  // c.x, c.y, c.z, n.x, n.y, n.z, e, mu
   ScratchRecords<T> j_[3];
   ScratchRecords<std::uint32_t> identity_;
+  const std::uint32_t* identity_data_ = nullptr;  // where identity_size_ entries are filled
   std::size_t identity_size_ = 0;
 };
 
