@@ -211,7 +211,8 @@ SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb:
   stats.model = job.model;
   stats.path = opt.path;
   stats.friction = job.friction;
-  stats.isa = table.isa;
+  // The scalar path is the baseline object's one-lane kernel, on every ISA.
+  stats.isa = simd ? table.isa : Isa::sse2;
   stats.layout = job.packed ? BodyLayout::packed : BodyLayout::soa;
   stats.accuracy = opt.accuracy;
   return stats;

@@ -32,6 +32,8 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/isa.hpp"
+
 #include "collide/error_bound.hpp"
 #include "support/run_cli.hpp"
 
@@ -209,13 +211,16 @@ const char* const kRequired[] = {"scene",
                                  "friction",
                                  "momentum_drift",
                                  "angular_momentum_drift",
-                                 "energy_drift"};
+                                 "energy_drift",
+                                 "isa",
+                                 "layout"};
 
-using Key = std::tuple<std::string, bool, std::string, std::string, std::string, int>;  // scene, friction, variant,
-                                                                                        // precision, model, threads
+// scene, friction, variant, precision, model, threads, isa
+using Key = std::tuple<std::string, bool, std::string, std::string, std::string, int, std::string>;
 Key key_of(const Json& row) {
   return {row.at("scene").str,     row.at("friction").b, row.at("variant").str,
-          row.at("precision").str, row.at("model").str,  static_cast<int>(row.at("threads").num)};
+          row.at("precision").str, row.at("model").str,  static_cast<int>(row.at("threads").num),
+          row.at("isa").str};
 }
 
 bool is_kernel(const Json& row) { return row.at("variant").str == "scalar" || row.at("variant").str == "simd"; }
@@ -245,14 +250,23 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
   std::set<Key> expected;
   for (const std::string scene : {"pairs", "debris"}) {
     for (const bool friction : {false, true}) {
-      expected.insert({scene, friction, "reference", "long double", "rigid", 1});
-      expected.insert({scene, friction, "reference", "double", "rigid", 1});
-      expected.insert({scene, friction, "textbook", "float", "rigid", 1});
-      expected.insert({scene, friction, "textbook", "double", "rigid", 1});
-      for (const std::string variant : {"scalar", "simd"}) {
-        for (const std::string precision : {"float", "double"}) {
-          for (const std::string model : {"particle", "sphere", "rigid"}) {
-            for (const int threads : {1, 2}) expected.insert({scene, friction, variant, precision, model, threads});
+      expected.insert({scene, friction, "reference", "long double", "rigid", 1, "sse2"});
+      expected.insert({scene, friction, "reference", "double", "rigid", 1, "sse2"});
+      expected.insert({scene, friction, "textbook", "float", "rigid", 1, "sse2"});
+      expected.insert({scene, friction, "textbook", "double", "rigid", 1, "sse2"});
+      for (const std::string precision : {"float", "double"}) {
+        for (const std::string model : {"particle", "sphere", "rigid"}) {
+          for (const int threads : {1, 2}) {
+            // The scalar path is the baseline object's; SIMD runs the default ISA ...
+            expected.insert({scene, friction, "scalar", precision, model, threads, "sse2"});
+            expected.insert(
+                {scene, friction, "simd", precision, model, threads, collide::to_string(collide::default_isa())});
+          }
+          // ... and every other ISA this CPU has, on the first thread count.
+          for (const collide::Isa isa : {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512}) {
+            if (collide::isa_supported(isa) && isa != collide::default_isa()) {
+              expected.insert({scene, friction, "simd", precision, model, 1, collide::to_string(isa)});
+            }
           }
         }
       }
@@ -260,11 +274,11 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
   }
   // The peer row exists exactly when the report says Bullet was built in.
   const bool bullet = json_->at("peer").str.rfind("bullet", 0) == 0;
-  if (bullet) expected.insert({"pairs", false, "bullet", "float", "rigid", 1});
+  if (bullet) expected.insert({"pairs", false, "bullet", "float", "rigid", 1, "sse2"});
   for (const Key& k : expected) {
     EXPECT_EQ(seen.count(k), 1U) << "no row for " << std::get<0>(k) << (std::get<1>(k) ? " friction " : " ")
                                  << std::get<2>(k) << " " << std::get<3>(k) << " " << std::get<4>(k) << " "
-                                 << std::get<5>(k) << " threads";
+                                 << std::get<5>(k) << " threads " << std::get<6>(k);
   }
   EXPECT_EQ(seen.size(), expected.size()) << "rows beyond the expected variants";
 }

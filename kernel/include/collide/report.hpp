@@ -35,8 +35,13 @@ struct ReportRow {
   int threads = 1;
   std::size_t n = 0;      ///< collisions per timed solve
   std::size_t lanes = 1;  ///< SIMD width of the path
-  int runs = 0;           ///< timed runs; the speed is their median
-  double seconds = 0;     ///< median time of one solve
+  /// Instruction set the row's code ran with: the SIMD kernel's ISA for simd
+  /// rows; "sse2", the x86-64 baseline everything else is compiled for, for
+  /// the scalar path, the references, the textbook loop and Bullet.
+  std::string isa = "sse2";
+  std::string layout = "soa";  ///< body layout the kernel ran on ("soa" or "packed"; SolveStats::layout)
+  int runs = 0;                ///< timed runs; the speed is their median
+  double seconds = 0;          ///< median time of one solve
   double collisions_per_second = 0;
   double bytes_per_collision = 0;     ///< traffic.hpp, in the row's precision
   double bandwidth_fraction = 0;      ///< collisions/s x bytes / triad bandwidth (same thread count)
@@ -70,7 +75,7 @@ struct MachineInfo {
   std::vector<double> triad_bytes_per_second;             ///< best pass (the bound), same order
   std::vector<double> triad_median_bytes_per_second;      ///< median pass, same order
   std::size_t triad_array_bytes = 0;
-  std::string simd_build;  ///< e.g. "AVX2: 8 float / 4 double lanes"
+  std::string simd_build;  ///< e.g. "avx512 (of sse2, avx2, avx512): 16 float / 8 double lanes"
   double load_average = -1;
 };
 

@@ -106,7 +106,7 @@ void sort_report_rows(Report& report) {
   auto key = [](const ReportRow& r) {
     const bool kernel = r.variant == "scalar" || r.variant == "simd";
     return std::make_tuple(r.scene == "pairs" ? 0 : 1, r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant),
-                           model_rank(r.model), precision_rank(r.precision), variant_rank(r.variant), r.threads);
+                           model_rank(r.model), precision_rank(r.precision), variant_rank(r.variant), r.isa, r.threads);
   };
   std::stable_sort(report.rows.begin(), report.rows.end(),
                    [&](const ReportRow& a, const ReportRow& b) { return key(a) < key(b); });
@@ -149,8 +149,8 @@ std::string format_report_table(const Report& report) {
   out += line;
 
   const char* const header =
-      "scene   fric variant   precision   model    thr         n  Mcoll/s     bw   max err   p99 err   max rel"
-      "       dP       dL       dE  note\n";
+      "scene   fric variant   precision   model    isa    layout thr         n  Mcoll/s     bw   max err   p99 err"
+      "   max rel       dP       dL       dE  note\n";
   out += header;
   std::string previous_group;
   for (const ReportRow& r : report.rows) {
@@ -158,10 +158,12 @@ std::string format_report_table(const Report& report) {
     if (!previous_group.empty() && group != previous_group) out += "\n";
     previous_group = group;
     std::snprintf(
-        line, sizeof line, "%-7s %-4s %-9s %-11s %-8s %3d %9zu %8.2f %5.1f%% %9.3g %9.3g %9.2e %8.1e %8.1e %8.1e  %s\n",
-        r.scene.c_str(), r.friction ? "mu" : "-", r.variant.c_str(), r.precision.c_str(), r.model.c_str(), r.threads,
-        r.n, r.collisions_per_second / 1e6, 100.0 * r.bandwidth_fraction, r.max_err_eps, r.p99_err_eps, r.max_rel_err,
-        r.momentum_drift, r.angular_momentum_drift, r.energy_drift, r.note.c_str());
+        line, sizeof line,
+        "%-7s %-4s %-9s %-11s %-8s %-6s %-6s %3d %9zu %8.2f %5.1f%% %9.3g %9.3g %9.2e %8.1e %8.1e %8.1e  %s\n",
+        r.scene.c_str(), r.friction ? "mu" : "-", r.variant.c_str(), r.precision.c_str(), r.model.c_str(),
+        r.isa.c_str(), r.layout.c_str(), r.threads, r.n, r.collisions_per_second / 1e6, 100.0 * r.bandwidth_fraction,
+        r.max_err_eps, r.p99_err_eps, r.max_rel_err, r.momentum_drift, r.angular_momentum_drift, r.energy_drift,
+        r.note.c_str());
     out += line;
   }
   if (!report.sweep.empty()) {
@@ -227,7 +229,8 @@ std::string format_report_json(const Report& report) {
          ", \"model\": " + json_string(r.model) + ", \"precision\": " + json_string(r.precision) +
          ", \"simd\": " + (r.simd ? "true" : "false") + ", \"friction\": " + (r.friction ? "true" : "false") +
          ", \"threads\": " + std::to_string(r.threads) + ", \"n\": " + std::to_string(r.n) +
-         ", \"lanes\": " + std::to_string(r.lanes) + ", \"runs\": " + std::to_string(r.runs) +
+         ", \"lanes\": " + std::to_string(r.lanes) + ", \"isa\": " + json_string(r.isa) +
+         ", \"layout\": " + json_string(r.layout) + ", \"runs\": " + std::to_string(r.runs) +
          ", \"seconds\": " + json_number(r.seconds) +
          ", \"collisions_per_second\": " + json_number(r.collisions_per_second) +
          ", \"bytes_per_collision\": " + json_number(r.bytes_per_collision) +

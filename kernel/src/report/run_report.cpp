@@ -56,12 +56,14 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "collide/bandwidth.hpp"
 #include "collide/error_bound.hpp"
 #include "collide/generate.hpp"
+#include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/reference.hpp"
 #include "collide/report.hpp"
@@ -250,8 +252,15 @@ class Runner {
     m.l1d_bytes = cache_bytes(1);
     m.l2_bytes = cache_bytes(2);
     m.l3_bytes = cache_bytes(3);
-    m.simd_build =
-        std::to_string(simd_width<float>()) + " float / " + std::to_string(simd_width<double>()) + " double lanes";
+    {
+      std::string supported;
+      for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+        if (isa_supported(isa)) supported += std::string(supported.empty() ? "" : ", ") + to_string(isa);
+      }
+      m.simd_build = std::string("simd rows: ") + to_string(default_isa()) + " (this CPU has " + supported +
+                     "): " + std::to_string(simd_width<float>()) + " float / " + std::to_string(simd_width<double>()) +
+                     " double lanes";
+    }
     for (const int t : config_.threads) {
       if (std::find(m.triad_threads.begin(), m.triad_threads.end(), t) != m.triad_threads.end()) continue;
       progress_->show("triad bandwidth, " + std::to_string(t) + " thread(s)");
@@ -265,22 +274,36 @@ class Runner {
   }
 
   [[nodiscard]] std::size_t expected_rows() const {
-    const std::size_t kernel = std::size_t{2 /*precisions*/ * 3 /*models*/ * 2 /*paths*/} * config_.threads.size();
+    const std::size_t kernel = std::size_t{2 /*precisions*/ * 3 /*models*/} * kernel_variants().size();
     const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
     std::size_t rows = std::size_t{2 /*scenes*/ * 2 /*friction*/} * (kernel + slow);
     if (!bullet_version().empty()) ++rows;
     return rows;
   }
 
-  const Solver& solver(Path path, int threads) {
-    auto& slot = solvers_[{path == Path::simd ? 1 : 0, threads}];
+  const Solver& solver(Path path, int threads, Isa isa = Isa::automatic) {
+    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa), threads}];
     if (!slot) {
       SolverOptions options;
       options.path = path;
       options.threads = threads;
+      options.isa = isa;
       slot = std::make_unique<Solver>(options);
     }
     return *slot;
+  }
+
+  /// The kernel rows of one scene: scalar and SIMD (the default ISA) at every
+  /// thread count, and SIMD on every other ISA the CPU has at the first.
+  [[nodiscard]] std::vector<std::tuple<Path, int, Isa>> kernel_variants() const {
+    std::vector<std::tuple<Path, int, Isa>> v;
+    for (const Path path : kPaths) {
+      for (const int threads : config_.threads) v.emplace_back(path, threads, Isa::automatic);
+    }
+    for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+      if (isa_supported(isa) && isa != default_isa()) v.emplace_back(Path::simd, config_.threads.front(), isa);
+    }
+    return v;
   }
 
   // -- rows ------------------------------------------------------------------
@@ -358,9 +381,9 @@ class Runner {
         }
       }
 
-      for (const Path path : kPaths) {
-        for (const int threads : config_.threads) {
-          const Solver& s = solver(path, threads);
+      for (const auto& [path, threads, isa] : kernel_variants()) {
+        {
+          const Solver& s = solver(path, threads, isa);
           ReportRow row = new_row(kind, to_string(path), model, precision_name<T>(), friction, threads, n);
           row.simd = path == Path::simd;
           progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
@@ -371,6 +394,8 @@ class Runner {
               config_.runs, [&] { saved.restore(bodies); },
               [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
           row.lanes = stats.lanes;
+          row.isa = to_string(stats.isa);
+          row.layout = to_string(stats.layout);
           finish_speed(row, std::move(seconds), sizeof(T), model);
 
           // The error sample, solved by the same solver.
