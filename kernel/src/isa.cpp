@@ -36,15 +36,22 @@ Isa parse_isa(std::string_view name) {
 
 namespace {
 
+/// The widest ISA that both the CPU has and this build has a kernel for
+/// (COLLIDE_HAVE_KERNEL_*, kernel/CMakeLists.txt: a clang build has no
+/// AVX-512 kernel).
 Isa detect() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_cpu_init();
+#if defined(COLLIDE_HAVE_KERNEL_avx512)
   // AVX-512 as the kernel is compiled for it: F, BW, DQ and VL.
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512vl")) {
     return Isa::avx512;
   }
+#endif
+#if defined(COLLIDE_HAVE_KERNEL_avx2)
   if (__builtin_cpu_supports("avx2")) return Isa::avx2;
+#endif
 #endif
   return Isa::sse2;
 }
@@ -81,7 +88,8 @@ Isa resolve_isa(Isa requested) {
   if (requested == Isa::automatic) return default_isa();
   if (!isa_supported(requested)) {
     throw std::invalid_argument(std::string("instruction set ") + to_string(requested) +
-                                " is not supported by this CPU (it supports up to " + to_string(best_isa()) + ")");
+                                " is not supported by this CPU or build (it supports up to " + to_string(best_isa()) +
+                                ")");
   }
   return requested;
 }

@@ -131,12 +131,15 @@ namespace detail {
 const KernelTable& kernel_table(Isa isa) {
 #if defined(__x86_64__)
   switch (isa) {
+#if defined(COLLIDE_HAVE_KERNEL_avx512)
     case Isa::avx512:
       return kernel_table_avx512();
+#endif
+#if defined(COLLIDE_HAVE_KERNEL_avx2)
     case Isa::avx2:
       return kernel_table_avx2();
-    case Isa::sse2:
-    case Isa::automatic:
+#endif
+    default:
       break;
   }
   return kernel_table_sse2();

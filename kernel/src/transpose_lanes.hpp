@@ -95,15 +95,7 @@ COLLIDE_LANE_INLINE void transpose_rows(const typename V::value_type* const* row
   using T = typename V::value_type;
 #if defined(__SSE2__)
   if constexpr (std::is_same_v<T, float> && (W == 4 || W == 8 || W == 16)) {
-    // Per group of four rows, within each 128-bit lane j: s[k] holds column
-    // 4j + k of those rows (unpack, then shuffle).
-#if defined(__AVX512F__)
-    using R = std::conditional_t<W == 16, __m512, std::conditional_t<W == 8, __m256, __m128>>;
-#elif defined(__AVX__)
-    using R = std::conditional_t<W == 8, __m256, __m128>;
-#else
-    using R = __m128;
-#endif
+    // The W rows as W registers, transposed (transpose_float_registers).
     auto loadu = [](const float* p) COLLIDE_LANE_LAMBDA {
       if constexpr (W == 4) {
         return _mm_loadu_ps(p);
@@ -117,6 +109,7 @@ COLLIDE_LANE_INLINE void transpose_rows(const typename V::value_type* const* row
 #endif
       }
     };
+    using R = decltype(loadu(rows[0]));
     R r[W];
     for (std::size_t l = 0; l < W; ++l) r[l] = loadu(rows[l] + offset);
     R o[W];

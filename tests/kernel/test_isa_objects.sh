@@ -16,7 +16,10 @@
 #      the same bytes whatever the ISA and is not code;
 #   2. the baseline objects (the SSE2 kernel and every other object of the
 #      library) contain no ymm or zmm register, and the AVX2 object no zmm;
-#   3. the checks can fail: the AVX2 object does use ymm and the AVX-512
+#   3. no fused multiply-add instruction in any object (the floating-point
+#      policy: AVX-512 includes FMA, and only -ffp-contract=off keeps the
+#      compiler from using it);
+#   4. the checks can fail: the AVX2 object does use ymm and the AVX-512
 #      object zmm (otherwise the grep would prove nothing).
 #
 # Usage: test_isa_objects.sh NM OBJDUMP AVX2_OBJECT AVX512_OBJECT BASELINE_OBJECT...
@@ -63,7 +66,16 @@ if grep -q -E '%zmm[0-9]' "$tmp/avx2.asm"; then
   failed=1
 fi
 
-# 3. The wide objects do use their registers.
+# 3. No FMA anywhere.
+for o in "$avx2" "$avx512" "${baseline[@]}"; do
+  "$objdump_tool" -d --no-show-raw-insn "$o" >"$tmp/asm"
+  if grep -m1 -E 'vf(n)?m(add|sub)[0-9]{3}' "$tmp/asm" >"$tmp/hit"; then
+    echo "FAIL: $o contains a fused multiply-add: $(cat "$tmp/hit")" >&2
+    failed=1
+  fi
+done
+
+# 4. The wide objects do use their registers.
 if ! grep -q -E '%ymm[0-9]' "$tmp/avx2.asm"; then
   echo "FAIL: the AVX2 object has no ymm register: is it compiled for AVX2?" >&2
   failed=1
