@@ -139,9 +139,9 @@ void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, con
     throw std::length_error("collide::Schedule::build: " + std::to_string(n) +
                             " contacts; a schedule holds at most 2^32 - 2");
   }
-  const std::size_t workers =
-      threads > 0 ? static_cast<std::size_t>(threads)
-                  : static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const std::size_t workers = threads > 0
+                                  ? static_cast<std::size_t>(threads)
+                                  : static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   contact_count_ = n;
   body_count_ = body_count;
   conflicts_ = 0;

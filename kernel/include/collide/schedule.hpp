@@ -97,6 +97,7 @@ class Schedule {
 
 extern template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*, int);
 extern template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*, int);
-extern template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*, int);
+extern template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*,
+                                                  int);
 
 }  // namespace collide
