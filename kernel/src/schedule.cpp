@@ -1,7 +1,7 @@
 // schedule.cpp - the level schedule of schedule.hpp, built in four passes.
 //
 // 1. Body table (parallel, streaming over bodies): body_next_[i] is the first
-//    free batch of body i, 0 to start with, or kImmovable for a body with
+//    free batch of body i, 0 to start with, or a sentinel for a body with
 //    inverse mass 0. Folding "movable" into the table means the level pass
 //    reads one random word per body instead of two (the inverse mass and the
 //    batch), and the inverse masses are read once, in order.
@@ -12,11 +12,16 @@
 //    levels are a max-plus function of every body's incoming batch, and
 //    evaluating it costs a second pass). On scattered bodies (the debris
 //    scene: random indices over contacts/2 bodies) it is bound by the latency
-//    of the two random body_next_ words, which the indices kPrefetchDistance
+//    of the two random body_next_ entries, which the indices kPrefetchDistance
 //    contacts ahead make predictable: prefetching them keeps enough misses in
 //    flight. It counts nothing per level: a histogram increment there is a
 //    store-to-load chain whenever neighbours share a level (every contact on
 //    the pairs scene), and cost a fifth of the pass (measured).
+//    Both arrays hold one byte per body and per contact while the levels fit
+//    (fewer than 254 batches: every scene but long chains): the body table of
+//    1M bodies then fits in L2, and every pass streams a quarter of the
+//    bytes. The first contact whose level does not fit widens both arrays to
+//    32-bit words in place, and the pass goes on from that contact.
 // 3. Stable counting sort by level (parallel over chunks of contacts): each
 //    chunk counts its levels, a prefix over (level, chunk) gives every chunk
 //    its first slot in every batch, and each chunk scatters its contacts in
@@ -24,11 +29,13 @@
 //    number of chunks; a scene of one level (the pairs scene) is the identity.
 // 4. Contiguity and the largest batch: O(batches).
 //
-// Measured on the debris scene at 2M contacts (AMD EPYC Zen 4, one thread,
-// CPU time of the build): the sequential build of one pass reading inv_mass
-// and body_next_ per body, then counting sort, took 18.6 ms; the body table
-// and prefetch alone bring the level pass from 11.8 to 4.6 ms; the bench rows
-// schedule/debris/... give the whole build, old against new.
+// Measured on the debris scene at 2M contacts (AMD EPYC Zen 4, CPU time of
+// one thread, min of 15, on a loaded machine): the level pass of the previous
+// build (one pass reading inv_mass and the 32-bit body_next_ per body, with
+// the histogram) 11.8 ms; the body table and a prefetch 16 contacts ahead
+// 5.8 ms, without the histogram 4.6 ms, in bytes 4.2 ms; prefetching 8 ahead
+// leaves misses exposed, 16 to 64 are within 5%. The bench rows
+// schedule/<scene>/... time the whole build.
 #include "collide/schedule.hpp"
 
 #include <algorithm>
@@ -45,8 +52,7 @@
 namespace collide {
 namespace {
 
-/// body_next_ of a body that never conflicts (inverse mass 0). A level is at
-/// most contacts - 1 < kImmovable - 1, so no level + 1 equals it.
+/// The wide body-table sentinel; contact counts stay below it.
 constexpr std::uint32_t kImmovable = std::numeric_limits<std::uint32_t>::max();
 
 /// Contacts ahead whose bodies the level pass prefetches. Measured on the
@@ -90,41 +96,77 @@ void for_each_chunk(std::size_t items, std::size_t chunks, const F& f) {
       std::size_t{0}, chunks, [&](std::size_t c) { f(c, begin(c), begin(c + 1)); }, tbb::simple_partitioner());
 }
 
-/// Pass 2: the level of every contact from the body table; returns the
-/// number of levels and adds the dependencies met to `conflicts`.
-std::uint32_t assign_levels(const BodyIndex* a, const BodyIndex* b, std::size_t n, std::uint32_t* next,
-                            std::uint32_t* level, std::size_t& conflicts) {
-  std::uint32_t levels = 0;
+/// The body-table word of a body that never conflicts (inverse mass 0). No
+/// level + 1 equals it: a narrow pass stops before (see assign_levels), and a
+/// wide level is at most contacts - 1 < 2^32 - 2.
+template <class Word>
+constexpr Word kImmovableWord = std::numeric_limits<Word>::max();
+
+/// Pass 1 for the body range [begin, end).
+template <class Word, class T>
+void fill_body_table(const T* inv_mass, std::size_t begin, std::size_t end, Word* next) {
+  for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i] != T(0) ? Word{0} : kImmovableWord<Word>;
+}
+
+/// Pass 2 from contact k on: the level of each contact from the body table.
+/// Raises `levels` to the number of levels, adds the dependencies met to
+/// `conflicts`, and returns the contact where it stopped: n, or for a narrow
+/// Word the first contact whose level + 1 would not fit below the sentinel,
+/// left untouched.
+template <class Word>
+std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __restrict b, std::size_t k, std::size_t n,
+                          Word* __restrict next, Word* __restrict level, std::uint32_t& levels,
+                          std::size_t& conflicts) {
+  constexpr Word immovable = kImmovableWord<Word>;
+  std::uint32_t count = levels;
   std::size_t met = 0;
-  const auto one = [&](std::size_t k) {
-    const BodyIndex i = a[k];
-    const BodyIndex j = b[k];
-    const std::uint32_t next_i = next[i];
-    const std::uint32_t next_j = next[j];
-    const bool movable_i = next_i != kImmovable;
-    const bool movable_j = next_j != kImmovable;
-    const std::uint32_t after_i = movable_i ? next_i : 0;
-    const std::uint32_t after_j = movable_j ? next_j : 0;
+  const auto one = [&](std::size_t c) {
+    const BodyIndex i = a[c];
+    const BodyIndex j = b[c];
+    const Word next_i = next[i];
+    const Word next_j = next[j];
+    const bool movable_i = next_i != immovable;
+    const bool movable_j = next_j != immovable;
+    const Word after_i = movable_i ? next_i : Word{0};
+    const Word after_j = movable_j ? next_j : Word{0};
+    const Word L = std::max(after_i, after_j);
+    if constexpr (sizeof(Word) < sizeof(std::uint32_t)) {
+      if (L == immovable - 1) return false;
+    }
     met += static_cast<std::size_t>(after_i > 0) + static_cast<std::size_t>(after_j > 0);
-    const std::uint32_t L = std::max(after_i, after_j);
-    level[k] = L;
-    // Branches, not selects: a select stores kImmovable back into the
+    level[c] = L;
+    // Branches, not selects: a select stores the sentinel back into the
     // ground's word and chains every ground contact through it (measured
     // slower). a == b is impossible (validate()) but harmless here.
-    if (movable_i) next[i] = L + 1;
-    if (movable_j) next[j] = L + 1;
-    levels = std::max(levels, L + 1);
+    if (movable_i) next[i] = static_cast<Word>(L + 1);
+    if (movable_j) next[j] = static_cast<Word>(L + 1);
+    count = std::max<std::uint32_t>(count, std::uint32_t{L} + 1);
+    return true;
   };
   const std::size_t ahead = n > kPrefetchDistance ? n - kPrefetchDistance : 0;
-  std::size_t k = 0;
-  for (; k < ahead; ++k) {
+  bool fits = true;
+  for (; k < ahead && fits; ++k) {
     prefetch_for_write(next + a[k + kPrefetchDistance]);
     prefetch_for_write(next + b[k + kPrefetchDistance]);
-    one(k);
+    fits = one(k);
   }
-  for (; k < n; ++k) one(k);
+  for (; k < n && fits; ++k) fits = one(k);
+  levels = count;
   conflicts += met;
-  return levels;
+  return fits ? k : k - 1;
+}
+
+/// Turns the first `count` bytes of `words` into `count` words, the byte
+/// sentinel into the word sentinel.
+void widen(std::vector<std::uint32_t>& words, std::size_t count) {
+  words.resize(count);  // keeps the bytes of the narrow words
+  std::uint32_t* const wide = words.data();
+  const auto* const narrow = reinterpret_cast<const std::uint8_t*>(wide);
+  // Backwards: word i covers bytes 4i..4i+3, which are read already.
+  for (std::size_t i = count; i-- > 0;) {
+    const std::uint8_t v = narrow[i];
+    wide[i] = v == kImmovableWord<std::uint8_t> ? kImmovable : v;
+  }
 }
 
 }  // namespace
@@ -145,24 +187,37 @@ void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, con
   contact_count_ = n;
   body_count_ = body_count;
   conflicts_ = 0;
-  level_.resize(n);
-  body_next_.resize(body_count);
   order_.resize(n);
-
-  // 1. Body table.
-  std::uint32_t* const next = body_next_.data();
-  for_each_chunk(body_count, chunk_count(body_count, workers), [&](std::size_t, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i] != T(0) ? 0 : kImmovable;
-  });
-
-  // 2. Levels, in input order.
 #ifndef NDEBUG
   for (std::size_t k = 0; k < n; ++k) assert(contacts.a[k] < body_count && contacts.b[k] < body_count);
 #endif
-  std::uint32_t* const level = level_.data();
-  const std::uint32_t levels = assign_levels(contacts.a, contacts.b, n, next, level, conflicts_);
 
-  // 3. Stable counting sort by level.
+  // Passes 1 and 2 on one byte per body and per contact while the levels fit
+  // in it (every scene of fewer than 254 batches): a quarter of the random
+  // lines and of the bytes streamed. The first contact that would need a
+  // wider level switches both arrays to words, and the pass goes on from it.
+  body_next_.resize((body_count + 3) / 4);
+  level_.resize((n + 3) / 4);
+  auto* const next8 = reinterpret_cast<std::uint8_t*>(body_next_.data());
+  for_each_chunk(body_count, chunk_count(body_count, workers), [&](std::size_t, std::size_t begin, std::size_t end) {
+    fill_body_table(inv_mass, begin, end, next8);
+  });
+  std::uint32_t levels = 0;
+  const std::size_t stop = assign_levels(contacts.a, contacts.b, 0, n, next8,
+                                         reinterpret_cast<std::uint8_t*>(level_.data()), levels, conflicts_);
+  if (stop == n) {
+    sort_by_level(reinterpret_cast<const std::uint8_t*>(level_.data()), levels, workers);
+  } else {
+    widen(body_next_, body_count);
+    widen(level_, n);
+    assign_levels(contacts.a, contacts.b, stop, n, body_next_.data(), level_.data(), levels, conflicts_);
+    sort_by_level(static_cast<const std::uint32_t*>(level_.data()), levels, workers);
+  }
+}
+
+template <class Level>
+void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers) {
+  const std::size_t n = contact_count_;
   std::uint32_t* const order = order_.data();
   batch_begin_.assign(static_cast<std::size_t>(levels) + 1, 0);
   std::size_t chunks = chunk_count(n, workers);
@@ -208,7 +263,7 @@ void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, con
     });
   }
 
-  // 4. Contiguity and the largest batch.
+  // Pass 4: contiguity and the largest batch.
   contiguous_.assign(levels, 0);
   largest_batch_ = 0;
   for (std::size_t L = 0; L < levels; ++L) {

@@ -27,9 +27,10 @@
 // tbb::task_arena::execute), or on at most `threads` threads. The schedule is
 // the same for every thread count, bit for bit.
 //
-// Memory: 4 bytes per contact for `order`, 4 per contact of scratch, 4 per
-// body of scratch, 5 per batch, and when the sort runs on more than one
-// thread at most 1 byte per contact of per-thread counts. Buffers are kept
+// Memory: 4 bytes per contact for `order`, 1 per contact and 1 per body of
+// scratch (4 and 4 for a scene of 254 batches or more), 5 per batch, and when
+// the sort runs on more than one thread at most 1 byte per contact of
+// per-thread counts. Buffers are kept
 // between builds, so a schedule rebuilt for a scene of the same size does not
 // allocate.
 #pragma once
@@ -87,9 +88,13 @@ class Schedule {
   std::size_t body_count_ = 0;
   std::size_t largest_batch_ = 0;
   std::size_t conflicts_ = 0;
+  /// Passes 3 and 4 of schedule.cpp: groups contacts by level.
+  template <class Level>
+  void sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers);
+
   std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> level_;      // scratch: batch of each contact
-  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body
+  std::vector<std::uint32_t> level_;      // scratch: batch of each contact (bytes while batches < 254)
+  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body (bytes, likewise)
   std::vector<std::uint32_t> batch_begin_;
   std::vector<std::uint8_t> contiguous_;
   std::vector<std::uint32_t> slot_;  // scratch: per-chunk counts, then slots, of the parallel sort
