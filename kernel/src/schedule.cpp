@@ -39,6 +39,7 @@
 #include "collide/schedule.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <limits>
 #include <numeric>
@@ -156,6 +157,31 @@ std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __rest
   return fits ? k : k - 1;
 }
 
+/// Adds the number of contacts of each level in [begin, end) to count[L].
+/// Byte levels are counted in four interleaved tables: one table would make
+/// neighbours of the same level (every contact of a pairs scene) wait on each
+/// other's store.
+template <class Level>
+void count_levels(const Level* level, std::size_t begin, std::size_t end, std::uint32_t* count) {
+  if constexpr (sizeof(Level) == 1) {
+    std::array<std::array<std::uint32_t, 256>, 4> part{};
+    std::size_t k = begin;
+    for (; k + 4 <= end; k += 4) {
+      ++part[0][level[k]];
+      ++part[1][level[k + 1]];
+      ++part[2][level[k + 2]];
+      ++part[3][level[k + 3]];
+    }
+    for (; k < end; ++k) ++part[0][level[k]];
+    for (std::size_t L = 0; L < 256; ++L) {
+      const std::uint32_t sum = part[0][L] + part[1][L] + part[2][L] + part[3][L];
+      if (sum != 0) count[L] += sum;
+    }
+  } else {
+    for (std::size_t k = begin; k < end; ++k) ++count[level[k]];
+  }
+}
+
 /// Turns the first `count` bytes of `words` into `count` words, the byte
 /// sentinel into the word sentinel.
 void widen(std::vector<std::uint32_t>& words, std::size_t count) {
@@ -232,7 +258,7 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
     // batch_begin_[L + 1] counts level L, the prefix sum turns counts into
     // starts, and filling advances batch_begin_[L] to the end of level L;
     // shifting by one restores starts.
-    for (std::size_t k = 0; k < n; ++k) ++batch_begin_[level[k] + 1];
+    count_levels(level, 0, n, batch_begin_.data() + 1);
     for (std::size_t L = 1; L <= levels; ++L) batch_begin_[L] += batch_begin_[L - 1];
     for (std::size_t k = 0; k < n; ++k) order[batch_begin_[level[k]]++] = static_cast<std::uint32_t>(k);
     for (std::size_t L = levels; L > 0; --L) batch_begin_[L] = batch_begin_[L - 1];
@@ -245,7 +271,7 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
     std::uint32_t* const slot = slot_.data();
     for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
       std::uint32_t* const count = slot + c * levels;
-      for (std::size_t k = begin; k < end; ++k) ++count[level[k]];
+      count_levels(level, begin, end, count);
     });
     std::uint32_t start = 0;
     for (std::size_t L = 0; L < levels; ++L) {
