@@ -1,6 +1,6 @@
 // schedule.cpp - the level schedule of schedule.hpp, built in four passes.
 //
-// 1. Body table (parallel, streaming over bodies): body_next_[i] is the first
+// 1. Body table (streaming over bodies): body_next_[i] is the first
 //    free batch of body i, 0 to start with, or a sentinel for a body with
 //    inverse mass 0. Folding "movable" into the table means the level pass
 //    reads one random word per body instead of two (the inverse mass and the
@@ -27,6 +27,10 @@
 //    its first slot in every batch, and each chunk scatters its contacts in
 //    input order. The result is the sequential stable sort, whatever the
 //    number of chunks; a scene of one level (the pairs scene) is the identity.
+//    Passes 1 and 3 of a one-level scene stream a few bytes per contact and
+//    take a fraction of a millisecond per million: they stay on the calling
+//    thread, since waking workers for them cost more wall time than it saved
+//    on a loaded machine (measured: the pairs rows).
 // 4. Contiguity and the largest batch: O(batches).
 //
 // Measured on the debris scene at 2M contacts (AMD EPYC Zen 4, CPU time of
@@ -103,7 +107,7 @@ void for_each_chunk(std::size_t items, std::size_t chunks, const F& f) {
 template <class Word>
 constexpr Word kImmovableWord = std::numeric_limits<Word>::max();
 
-/// Pass 1 for the body range [begin, end).
+/// Pass 1 for the bodies [begin, end).
 template <class Word, class T>
 void fill_body_table(const T* inv_mass, std::size_t begin, std::size_t end, Word* next) {
   for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i] != T(0) ? Word{0} : kImmovableWord<Word>;
@@ -225,9 +229,7 @@ void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, con
   body_next_.resize((body_count + 3) / 4);
   level_.resize((n + 3) / 4);
   auto* const next8 = reinterpret_cast<std::uint8_t*>(body_next_.data());
-  for_each_chunk(body_count, chunk_count(body_count, workers), [&](std::size_t, std::size_t begin, std::size_t end) {
-    fill_body_table(inv_mass, begin, end, next8);
-  });
+  fill_body_table(inv_mass, 0, body_count, next8);
   std::uint32_t levels = 0;
   const std::size_t stop = assign_levels(contacts.a, contacts.b, 0, n, next8,
                                          reinterpret_cast<std::uint8_t*>(level_.data()), levels, conflicts_);
@@ -250,9 +252,7 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
   if (chunks > 1 && chunks * levels > n / kContactsPerCount) chunks = 1;
   if (levels == 1) {
     // One batch: every contact in input order.
-    for_each_chunk(n, chunks, [&](std::size_t, std::size_t begin, std::size_t end) {
-      std::iota(order + begin, order + end, static_cast<std::uint32_t>(begin));
-    });
+    std::iota(order, order + n, std::uint32_t{0});
     batch_begin_[1] = static_cast<std::uint32_t>(n);
   } else if (chunks == 1) {
     // batch_begin_[L + 1] counts level L, the prefix sum turns counts into

@@ -322,7 +322,7 @@ Topology all_shared_topology(std::size_t n) {
   return t;
 }
 
-// Sizes: scenes of 65536 contacts or bodies and more are split into chunks
+// Sizes: scenes of 65536 contacts and more are sorted in chunks
 // on 2 threads or more (32768 per chunk at least, schedule.cpp), the smaller
 // ones run on one; 16 is the prefetch distance.
 TEST(Schedule, EqualsPlainLevelRuleOnEveryShapeAndThreadCount) {
