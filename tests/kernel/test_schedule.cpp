@@ -401,7 +401,8 @@ TEST(Schedule, EmptySceneHasNoBatches) {
 }
 
 // Memory: 16 B per contact + 8 B per body + 8 B per batch + 256 B. The
-// documented footprint is 8 B per contact, 4 B per body, 5 B per batch.
+// documented footprint is 5 B per contact and 1 B per body (8 and 4 from 254
+// batches on), 5 B per batch, and up to 1 B per contact of per-chunk counts.
 TEST(Schedule, MemoryIsBoundedPerContactAndBody) {
   std::vector<std::pair<BodyIndex, BodyIndex>> chain;
   for (BodyIndex k = 0; k < 3000; ++k) chain.emplace_back(k, k + 1);
