@@ -14,6 +14,12 @@
 //   body); no movable body appears twice in a batch; `order` is a permutation,
 //   ascending in each batch; largest_batch, conflicts and the contiguity flags
 //   are what they claim.
+// * The build (body table, prefetched level pass, counting sort on 1 to 8
+//   threads, schedule.cpp) gives every output identical to a plain reference
+//   of the level rule written here, on random scenes of every shape: debris
+//   (scattered bodies, a ground under a quarter of the contacts), pairs, one
+//   shared movable body, bodies made immovable at random, dense scenes of a
+//   few hundred levels, and scenes too small to prefetch or to split.
 // * Contacts against an immovable body never conflict: 1e5 contacts on one
 //   ground body form one batch.
 // * The pairs scene is one contiguous batch.
@@ -29,6 +35,9 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -196,6 +205,169 @@ TEST(Schedule, RandomSharedScenesAreTheLevelSchedule) {
   }
 }
 
+// A contact topology and the inverse masses: all the schedule reads.
+struct Topology {
+  std::string name;
+  std::vector<BodyIndex> a, b;
+  std::vector<float> inv_mass;
+};
+
+/// The level rule, plainly: contact k goes one batch past the latest batch of
+/// the earlier contacts of its movable bodies; batches hold their contacts in
+/// input order.
+struct ReferenceSchedule {
+  std::vector<std::vector<std::uint32_t>> batches;
+  std::size_t conflicts = 0;
+
+  explicit ReferenceSchedule(const Topology& t) {
+    std::vector<std::size_t> batch_count_of_body(t.inv_mass.size(), 0);  // batches the body is already in
+    for (std::size_t k = 0; k < t.a.size(); ++k) {
+      std::size_t level = 0;
+      for (const BodyIndex i : {t.a[k], t.b[k]}) {
+        if (t.inv_mass[i] == 0) continue;
+        level = std::max(level, batch_count_of_body[i]);
+        if (batch_count_of_body[i] > 0) ++conflicts;
+      }
+      for (const BodyIndex i : {t.a[k], t.b[k]}) {
+        if (t.inv_mass[i] != 0) batch_count_of_body[i] = level + 1;
+      }
+      if (batches.size() <= level) batches.resize(level + 1);
+      batches[level].push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+};
+
+/// Every output of `s` against the reference.
+void expect_reference(const Topology& t, const Schedule& s) {
+  const ReferenceSchedule r(t);
+  ASSERT_EQ(s.contact_count(), t.a.size());
+  ASSERT_EQ(s.body_count(), t.inv_mass.size());
+  ASSERT_EQ(s.batch_count(), r.batches.size());
+  EXPECT_EQ(s.conflicts(), r.conflicts);
+  std::size_t begin = 0, largest = 0;
+  for (std::size_t k = 0; k < r.batches.size(); ++k) {
+    const std::vector<std::uint32_t>& want = r.batches[k];
+    ASSERT_EQ(s.batch_begin(k), begin) << "batch " << k;
+    ASSERT_EQ(s.batch_begin(k + 1), begin + want.size()) << "batch " << k;
+    ASSERT_EQ(batch(s, k), want) << "batch " << k;
+    bool contiguous = true;
+    for (std::size_t i = 1; i < want.size(); ++i) contiguous = contiguous && want[i] == want[i - 1] + 1;
+    EXPECT_EQ(s.batch_is_contiguous(k), contiguous) << "batch " << k;
+    largest = std::max(largest, want.size());
+    begin += want.size();
+  }
+  EXPECT_EQ(s.largest_batch(), largest);
+}
+
+/// n contacts over n/2 movable bodies at random (a != b), the ground (the last
+/// body, immovable) on side b of every fourth contact, like generate_debris;
+/// `ground_either_side` puts it on side a half of the time.
+Topology debris_topology(std::size_t n, std::uint64_t seed, bool ground_either_side = false) {
+  std::mt19937_64 rng(seed);
+  const std::size_t movable = std::max<std::size_t>(2, n / 2);
+  const auto ground = static_cast<BodyIndex>(movable);
+  Topology t{"debris n=" + std::to_string(n), {}, {}, std::vector<float>(movable + 1, 1.0f)};
+  t.inv_mass[ground] = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<BodyIndex>(rng() % movable);
+    BodyIndex j = ground;
+    if (k % 4 != 3) {
+      j = static_cast<BodyIndex>(rng() % (movable - 1));
+      if (j >= i) ++j;
+    }
+    const bool swap = ground_either_side && j == ground && (rng() & 1) != 0;
+    t.a.push_back(swap ? j : i);
+    t.b.push_back(swap ? i : j);
+  }
+  return t;
+}
+
+/// n contacts at random over `bodies` bodies, a fraction of them immovable
+/// (inverse mass 0 or -0, both immovable), some contacts between two
+/// immovable bodies.
+Topology random_topology(std::size_t n, std::size_t bodies, double immovable, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Topology t{
+      "random n=" + std::to_string(n) + " bodies=" + std::to_string(bodies), {}, {}, std::vector<float>(bodies, 0.5f)};
+  for (std::size_t i = 0; i < bodies; ++i) {
+    if (static_cast<double>(rng() % 1000) < immovable * 1000) t.inv_mass[i] = (i % 2) ? 0.0f : -0.0f;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto i = static_cast<BodyIndex>(rng() % bodies);
+    auto j = static_cast<BodyIndex>(rng() % (bodies - 1));
+    if (j >= i) ++j;
+    t.a.push_back(i);
+    t.b.push_back(j);
+  }
+  return t;
+}
+
+Topology pairs_topology(std::size_t n) {
+  Topology t{"pairs n=" + std::to_string(n), {}, {}, std::vector<float>(2 * n, 1.0f)};
+  for (std::size_t k = 0; k < n; ++k) {
+    t.a.push_back(static_cast<BodyIndex>(2 * k));
+    t.b.push_back(static_cast<BodyIndex>(2 * k + 1));
+  }
+  return t;
+}
+
+/// Every contact shares movable body 0 (on either side): one batch per contact.
+Topology all_shared_topology(std::size_t n) {
+  Topology t{"all shared n=" + std::to_string(n), {}, {}, std::vector<float>(n + 1, 1.0f)};
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto other = static_cast<BodyIndex>(k + 1);
+    t.a.push_back(k % 2 ? 0 : other);
+    t.b.push_back(k % 2 ? other : 0);
+  }
+  return t;
+}
+
+// Sizes: scenes of 65536 contacts and more are sorted in chunks
+// on 2 threads or more (32768 per chunk at least, schedule.cpp), the smaller
+// ones run on one; 16 is the prefetch distance.
+TEST(Schedule, EqualsPlainLevelRuleOnEveryShapeAndThreadCount) {
+  std::vector<Topology> scenes = {
+      debris_topology(200000, 1),
+      debris_topology(150001, 2, true),
+      debris_topology(3000, 3),
+      pairs_topology(100000),
+      pairs_topology(10),
+      all_shared_topology(5000),
+      random_topology(140000, 60000, 0.2, 4),   // immovable bodies at random, ~10 contacts per body
+      random_topology(70000, 700, 0.1, 5),      // dense: hundreds of batches, still split on 2 threads
+      random_topology(100000, 100000, 0.5, 6),  // half the bodies immovable
+      random_topology(17, 5, 0.4, 7),           // just past the prefetch distance
+      random_topology(15, 8, 0.0, 8),           // shorter than it
+      random_topology(1, 2, 0.0, 9),
+      random_topology(0, 2, 0.0, 10),
+  };
+  for (const Topology& t : scenes) {
+    for (const int threads : {1, 2, 3, 8, 0}) {
+      SCOPED_TRACE(t.name + ", threads " + std::to_string(threads));
+      ContactView<float> view;
+      view.count = t.a.size();
+      view.a = t.a.data();
+      view.b = t.b.data();
+      Schedule s;
+      s.build(view, t.inv_mass.size(), t.inv_mass.data(), threads);
+      expect_reference(t, s);
+      // A rebuild into used buffers, on another thread count, is the same.
+      s.build(view, t.inv_mass.size(), t.inv_mass.data(), threads == 1 ? 2 : 1);
+      expect_reference(t, s);
+    }
+  }
+}
+
+TEST(Schedule, NegativeThreadCountIsRejected) {
+  const Topology t = pairs_topology(4);
+  ContactView<float> view;
+  view.count = t.a.size();
+  view.a = t.a.data();
+  view.b = t.b.data();
+  Schedule s;
+  EXPECT_THROW(s.build(view, t.inv_mass.size(), t.inv_mass.data(), -1), std::invalid_argument);
+}
+
 // 1e5 contacts of distinct movable bodies with one ground body (on side a or
 // b) conflict nowhere: one batch, contiguous.
 TEST(Schedule, ContactsOnOneImmovableBodyFormOneBatch) {
@@ -229,7 +401,8 @@ TEST(Schedule, EmptySceneHasNoBatches) {
 }
 
 // Memory: 16 B per contact + 8 B per body + 8 B per batch + 256 B. The
-// documented footprint is 8 B per contact, 4 B per body, 5 B per batch.
+// documented footprint is 5 B per contact and 1 B per body (8 and 4 from 254
+// batches on), 5 B per batch, and up to 1 B per contact of per-chunk counts.
 TEST(Schedule, MemoryIsBoundedPerContactAndBody) {
   std::vector<std::pair<BodyIndex, BodyIndex>> chain;
   for (BodyIndex k = 0; k < 3000; ++k) chain.emplace_back(k, k + 1);

@@ -19,9 +19,20 @@
 // Immovable bodies (inverse mass 0) are never written by the kernels, so they
 // never conflict: a million debris contacts on one ground body form one batch.
 //
-// Memory: 4 bytes per contact for `order`, 4 per contact of scratch, 4 per
-// body of scratch, and 4 per batch. Buffers are kept between builds, so a
-// schedule rebuilt for a scene of the same size does not allocate.
+// Building is sequential where it must be: the batch of contact k depends on
+// every earlier contact, so one pass in input order assigns batches (with the
+// body words it will need prefetched, schedule.cpp). Grouping contacts by
+// batch is a stable counting sort that runs on threads, in the task arena of
+// the calling thread (TBB's default arena unless called inside a
+// tbb::task_arena::execute), or on at most `threads` threads. The schedule is
+// the same for every thread count, bit for bit.
+//
+// Memory: 4 bytes per contact for `order`, 1 per contact and 1 per body of
+// scratch (4 and 4 for a scene of 254 batches or more), 5 per batch, and when
+// the sort runs on more than one thread at most 1 byte per contact of
+// per-thread counts. Buffers are kept
+// between builds, so a schedule rebuilt for a scene of the same size does not
+// allocate.
 #pragma once
 
 #include <cstddef>
@@ -38,14 +49,17 @@ class Schedule {
   /// Builds the schedule. Bodies with inv_mass == 0 do not conflict.
   /// Precondition: every index is < bodies.count (see validate()).
   /// `bodies` is any body view (BodyView, SphereView, ParticleView): only
-  /// its count and inverse masses are read.
+  /// its count and inverse masses are read. `threads`: at most this many
+  /// threads; 0 means the concurrency of the calling thread's task arena.
+  /// The result does not depend on it. Throws std::invalid_argument if
+  /// threads < 0 and std::length_error beyond 2^32 - 2 contacts.
   template <class T, template <class> class View>
-  void build(const ContactView<T>& contacts, const View<T>& bodies) {
-    build(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass));
+  void build(const ContactView<T>& contacts, const View<T>& bodies, int threads = 0) {
+    build(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass), threads);
   }
   /// The same for any body model: only the inverse masses matter.
   template <class T>
-  void build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass);
+  void build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, int threads = 0);
 
   /// Number of contacts the schedule was built for.
   [[nodiscard]] std::size_t contact_count() const { return contact_count_; }
@@ -74,15 +88,21 @@ class Schedule {
   std::size_t body_count_ = 0;
   std::size_t largest_batch_ = 0;
   std::size_t conflicts_ = 0;
+  /// Passes 3 and 4 of schedule.cpp: groups contacts by level.
+  template <class Level>
+  void sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers);
+
   std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> level_;      // scratch: batch of each contact
-  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body
+  std::vector<std::uint32_t> level_;      // scratch: batch of each contact (bytes while batches < 254)
+  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body (bytes, likewise)
   std::vector<std::uint32_t> batch_begin_;
   std::vector<std::uint8_t> contiguous_;
+  std::vector<std::uint32_t> slot_;  // scratch: per-chunk counts, then slots, of the parallel sort
 };
 
-extern template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*);
-extern template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*);
-extern template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*);
+extern template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*, int);
+extern template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*, int);
+extern template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*,
+                                                  int);
 
 }  // namespace collide
