@@ -3,9 +3,11 @@
 // Design notes
 // ------------
 // * All input is read and validated before any output file is opened, and
-//   both outputs are written to temporaries that are renamed only when both
-//   are complete: bad input, or any failure, writes nothing and leaves
-//   pre-existing outputs untouched.
+//   regular outputs are written to temporaries that are renamed only when
+//   both are complete: bad input, or any failure, writes nothing and leaves
+//   pre-existing outputs untouched. An output that is stdout ("-"), a device
+//   or a FIFO is written in place (collide/output_file.hpp), after the
+//   temporaries and before their rename.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
 //   project reports as throughput; reading, scheduling and writing are timed
 //   separately.
@@ -52,8 +54,10 @@ const char* const kSolveUsage =
     "\n"
     "  --bodies FILE         bodies.csv: m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
     "  --contacts FILE       contacts.csv: a,b,cx,cy,cz,nx,ny,nz,e,mu\n"
-    "  --out-bodies FILE     result bodies file (replaced atomically)\n"
-    "  --out-impulses FILE   result impulses file (replaced atomically)\n"
+    "  --out-bodies FILE     result bodies file: a regular file is replaced\n"
+    "                        atomically; '-' (stdout), a device such as /dev/null\n"
+    "                        or a FIFO is written in place\n"
+    "  --out-impulses FILE   result impulses file, likewise (only one output may be '-')\n"
     "  --precision P         float or double (default double)\n"
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
@@ -177,11 +181,23 @@ int solve_scene(const SolveRequest& req) {
   {
     OutputFile out_bodies(req.out_bodies_path);
     OutputFile out_impulses(req.out_impulses_path);
-    write_bodies(out_bodies, table, std::as_const(bodies).view());
-    write_impulses(out_impulses, std::as_const(impulses).view());
-    // Both complete: only now does either replace its destination.
-    out_bodies.commit();
-    out_impulses.commit();
+    const auto write = [&](OutputFile& out) {
+      if (&out == &out_bodies) {
+        write_bodies(out_bodies, table, std::as_const(bodies).view());
+      } else {
+        write_impulses(out_impulses, std::as_const(impulses).view());
+      }
+    };
+    // A direct output (stdout, device, FIFO) cannot be taken back: write it
+    // after the temporaries, and flush it before they are renamed, so that a
+    // failure anywhere still leaves every regular destination untouched.
+    const bool bodies_first = !out_bodies.direct() || out_impulses.direct();
+    OutputFile& first = bodies_first ? out_bodies : out_impulses;
+    OutputFile& second = bodies_first ? out_impulses : out_bodies;
+    write(first);
+    write(second);
+    second.commit();
+    first.commit();
   }
   const double write_seconds = seconds_since(t_write);
 
@@ -259,6 +275,9 @@ int run_solve(int argc, char** argv) {
     std::error_code ec1, ec2;
     const auto a = std::filesystem::weakly_canonical(req.out_bodies_path, ec1);
     const auto b = std::filesystem::weakly_canonical(req.out_impulses_path, ec2);
+    if (req.out_bodies_path == kStdoutPath && req.out_impulses_path == kStdoutPath) {
+      throw UsageError("only one of --out-bodies and --out-impulses can be '-' (stdout)");
+    }
     if (req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b)) {
       throw UsageError("--out-bodies and --out-impulses must be different files");
     }
