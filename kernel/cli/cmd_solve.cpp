@@ -278,7 +278,9 @@ int run_solve(int argc, char** argv) {
     if (req.out_bodies_path == kStdoutPath && req.out_impulses_path == kStdoutPath) {
       throw UsageError("only one of --out-bodies and --out-impulses can be '-' (stdout)");
     }
-    if (req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b)) {
+    // One character device (/dev/null) may take both: nothing is replaced.
+    const bool same = req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b);
+    if (same && !std::filesystem::is_character_file(req.out_bodies_path, ec1)) {
       throw UsageError("--out-bodies and --out-impulses must be different files");
     }
   }

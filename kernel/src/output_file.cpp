@@ -32,6 +32,35 @@ Target classify(const std::string& path) {
   return S_ISREG(st.st_mode) ? Target::renamed : Target::direct;
 }
 
+/// True for a path that names an open descriptor rather than a file:
+/// /dev/stdout, /dev/fd/N, /proc/self/fd/N (directly or through symbolic
+/// links into /proc). Renaming onto it would replace the link in /dev (or
+/// fail in /proc), and the shell's redirection would never see the data, so
+/// such a path is written in place even when it leads to a regular file.
+bool names_a_descriptor(const std::string& path) {
+  namespace fs = std::filesystem;
+  auto in_proc = [](const std::string& p) { return p.rfind("/proc/", 0) == 0 || p.rfind("/dev/fd/", 0) == 0; };
+  if (in_proc(path)) return true;
+  fs::path p(path);
+  std::error_code ec;
+  for (int hop = 0; hop < 40 && fs::is_symlink(p, ec); ++hop) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) return false;
+    p = target.is_absolute() ? target : p.parent_path() / target;
+    if (in_proc(p.string())) return true;
+  }
+  return false;
+}
+
+/// Where the temporary is renamed to: the file a symbolic link leads to (the
+/// link itself stays a link), or the path itself.
+std::string rename_target(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_symlink(path, ec)) return path;
+  const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, ec);
+  return ec ? path : resolved.string();
+}
+
 std::string errno_text(const char* what, int err) { return std::string(what) + ": " + std::strerror(err); }
 
 }  // namespace
@@ -42,7 +71,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
     is_stdout_ = true;
     return;
   }
-  switch (classify(path_)) {
+  switch (names_a_descriptor(path_) ? Target::direct : classify(path_)) {
     case Target::directory:
       throw SceneError(path_, "cannot write: is a directory");
     case Target::direct: {
@@ -60,7 +89,8 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
     case Target::renamed:
       break;
   }
-  const std::filesystem::path dest(path_);
+  dest_ = rename_target(path_);
+  const std::filesystem::path dest(dest_);
   const std::string dir = dest.parent_path().string();
   // Same directory as the destination, so that rename() is atomic and never
   // crosses a file system; hidden, so a crash leaves no plausible output.
@@ -84,6 +114,7 @@ OutputFile::~OutputFile() { discard(); }
 
 OutputFile::OutputFile(OutputFile&& other) noexcept
     : path_(std::move(other.path_)),
+      dest_(std::move(other.dest_)),
       temp_path_(std::move(other.temp_path_)),
       file_(std::exchange(other.file_, nullptr)),
       is_stdout_(other.is_stdout_) {}
@@ -92,6 +123,7 @@ OutputFile& OutputFile::operator=(OutputFile&& other) noexcept {
   if (this != &other) {
     discard();
     path_ = std::move(other.path_);
+    dest_ = std::move(other.dest_);
     temp_path_ = std::move(other.temp_path_);
     file_ = std::exchange(other.file_, nullptr);
     is_stdout_ = other.is_stdout_;
@@ -137,7 +169,7 @@ void OutputFile::commit() {
     throw SceneError(path_, errno_text("write error", flushed ? close_err : err));
   }
   if (temp_path_.empty()) return;
-  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
+  if (std::rename(temp_path_.c_str(), dest_.c_str()) != 0) {
     const int rerr = errno;
     ::unlink(temp_path_.c_str());
     throw SceneError(path_, errno_text("cannot rename the temporary file into place", rerr));

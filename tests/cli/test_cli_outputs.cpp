@@ -11,6 +11,10 @@
 //   character device with the same device number after a solve writes to
 //   it, and no temporary is left next to it. Where mknod is not permitted
 //   the test says so and skips.
+// * Both outputs may go to one null device; a link into /proc (as
+//   /dev/stdout is; the test makes its own) is written in place, not
+//   replaced, even when stdout is a regular file;
+//   a symbolic link to a regular file stays a link and its file is replaced.
 // * A FIFO gets the data (a reader thread receives the same bytes a regular
 //   file gets) and is still a FIFO afterwards.
 // * Bad input opens no output: a FIFO held open by a reader receives no
@@ -148,6 +152,41 @@ TEST_F(OutputTargetTest, CharacterDeviceIsWrittenNotReplaced) {
   }
   EXPECT_EQ(slurp(path("ob.csv")), bodies);
   EXPECT_EQ(slurp(path("oj.csv")), impulses);
+
+  // Both outputs into the one null device: allowed, nothing replaced.
+  const RunResult both = solve(node.string(), node.string());
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  struct stat after {};
+  ASSERT_EQ(::lstat(node.c_str(), &after), 0);
+  EXPECT_TRUE(S_ISCHR(after.st_mode));
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(OutputTargetTest, LinkToTheStdoutDescriptorIsWrittenInPlace) {
+  // /dev/stdout is a link to /proc/self/fd/1; with stdout redirected to a
+  // regular file (run_program does that) a rename would replace the link and
+  // the redirection would never see the data. A private link of the same
+  // kind stands in for /dev/stdout, so a failure cannot touch /dev.
+  std::string bodies, impulses;
+  reference_outputs(bodies, impulses);
+  fs::create_symlink("/proc/self/fd/1", path("stdout"));
+  const RunResult r = solve(path("ob.csv").string(), path("stdout").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, impulses);
+  EXPECT_TRUE(fs::is_symlink(path("stdout"))) << "the link was replaced";
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(OutputTargetTest, SymlinkToARegularFileStaysALink) {
+  std::string bodies, impulses;
+  reference_outputs(bodies, impulses);
+  write_text(path("target.csv"), "old\n");
+  fs::create_symlink("target.csv", path("link.csv"));
+  const RunResult r = solve(path("ob.csv").string(), path("link.csv").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(path("link.csv")));
+  EXPECT_EQ(slurp(path("target.csv")), impulses);
+  EXPECT_TRUE(temporaries().empty());
 }
 
 TEST_F(OutputTargetTest, FifoGetsTheDataAndStaysAFifo) {

@@ -13,7 +13,11 @@
 //   /dev/null` turned /dev/null into a regular file for the whole machine;
 //   a reader waiting on a FIFO never got the data). Such an output cannot be
 //   atomic: what was written before a failure stays written.
-// * "-" is the standard output, also written directly (and not closed).
+// * "-" is the standard output, also written directly (and not closed); so
+//   are /dev/stdout, /dev/fd/N and anything linking into /proc, whatever
+//   they lead to.
+// * A symbolic link to a regular file stays a link: the temporary is made
+//   next to the file it leads to and renamed onto that file.
 // * Opening a FIFO blocks until a reader opens it, as a shell redirection
 //   does.
 //
@@ -55,6 +59,7 @@ class OutputFile {
  private:
   void discard() noexcept;
   std::string path_;
+  std::string dest_;       // what the temporary is renamed to: path_, or the file a link leads to
   std::string temp_path_;  // empty for a direct output
   std::FILE* file_ = nullptr;
   bool is_stdout_ = false;
