@@ -10,7 +10,10 @@
 //   temporaries and before their rename.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
 //   project reports as throughput; reading, scheduling and writing are timed
-//   separately.
+//   separately, and io_seconds (read + write) with io_fraction (its share of
+//   read + schedule + kernel + write) say how much of a run is file I/O: for
+//   large scenes nearly all of it (2M bodies: seconds of CSV against
+//   milliseconds of kernel).
 // * --check runs reference_solve<long double> on an exact copy of the inputs
 //   taken before the solve (convert_* copy without renormalising), and
 //   measures each impulse error in units of eps(T) * impulse_scale, the
@@ -65,7 +68,9 @@ const char* const kSolveUsage =
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
-    "  --stats               print one JSON object of statistics on stderr\n"
+    "  --stats               print one JSON object of statistics on stderr (kernel,\n"
+    "                        schedule, read and write times; io_fraction is the\n"
+    "                        share of file I/O, nearly all of a large scene's time)\n"
     "  --check               also run the long double reference and compare the\n"
     "                        impulses; exit 3 if an error exceeds the documented bound\n"
     "\n"
@@ -225,6 +230,11 @@ int solve_scene(const SolveRequest& req) {
     s += ", \"schedule_seconds\": " + json_number(schedule_seconds);
     s += ", \"read_seconds\": " + json_number(read_seconds);
     s += ", \"write_seconds\": " + json_number(write_seconds);
+    // File I/O against everything solve does: for large scenes the CSV text,
+    // not the kernel, is where the time goes (README, "Command line").
+    const double io_seconds = read_seconds + write_seconds;
+    s += ", \"io_seconds\": " + json_number(io_seconds);
+    s += ", \"io_fraction\": " + json_number(io_seconds / (io_seconds + schedule_seconds + kernel_seconds));
     if (req.check) {
       s += ", \"check\": true";
       s += ", \"max_impulse_error_eps\": " + json_number(check.max_error_eps);

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,7 +68,7 @@ struct SweepPoint {
 struct MachineInfo {
   std::string cpu;
   unsigned hardware_threads = 0;
-  std::size_t l1d_bytes = 0, l2_bytes = 0, l3_bytes = 0;  ///< one instance each
+  std::optional<std::size_t> l1d_bytes, l2_bytes, l3_bytes;  ///< one instance each; nullopt = unknown
   std::vector<int> triad_threads;                         ///< thread counts measured
   std::vector<double> triad_bytes_per_second;             ///< best pass (the bound), same order
   std::vector<double> triad_median_bytes_per_second;      ///< median pass, same order

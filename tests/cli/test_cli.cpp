@@ -462,6 +462,29 @@ TEST_F(CliTest, StatsIsOneJsonObjectWithTheDocumentedFields) {
   EXPECT_EQ(r.err.find("check"), std::string::npos) << "no check fields without --check";
 }
 
+/// The number after "key": in a one-line JSON object (NaN when absent).
+double stats_number(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+TEST_F(CliTest, StatsSaysHowMuchIsFileIo) {
+  const RunResult r = solve(kBodies, kContacts, {"--stats"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double read = stats_number(r.err, "read_seconds");
+  const double write = stats_number(r.err, "write_seconds");
+  const double io = stats_number(r.err, "io_seconds");
+  const double fraction = stats_number(r.err, "io_fraction");
+  const double rest = stats_number(r.err, "schedule_seconds") + stats_number(r.err, "kernel_seconds");
+  ASSERT_TRUE(std::isfinite(io)) << r.err;
+  // Printed with 9 significant digits: equal to that precision.
+  EXPECT_NEAR(io, read + write, 1e-8 * io + 1e-12) << r.err;
+  EXPECT_NEAR(fraction, io / (io + rest), 1e-6) << r.err;
+  EXPECT_GT(fraction, 0);
+  EXPECT_LE(fraction, 1);
+}
+
 TEST_F(CliTest, StatsReportsCheck) {
   const RunResult r = solve(kBodies, kContacts, {"--stats", "--check"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
