@@ -670,8 +670,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   print("load average before/after: %.2f / %.2f on %u CPUs%s\n", load_before, load_average(),
         std::thread::hardware_concurrency(),
         load_before > 0.5 ? " -- other processes were running: expect noisy rows, try --benchmark_repetitions=3" : "");
-  print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
-        collide::default_triad_array_bytes() >> 20);
+  print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20, collide::default_triad_array_bytes() >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
   if (!checks_ok) {
     print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");

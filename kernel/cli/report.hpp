@@ -69,9 +69,9 @@ struct MachineInfo {
   std::string cpu;
   unsigned hardware_threads = 0;
   std::optional<std::size_t> l1d_bytes, l2_bytes, l3_bytes;  ///< one instance each; nullopt = unknown
-  std::vector<int> triad_threads;                         ///< thread counts measured
-  std::vector<double> triad_bytes_per_second;             ///< best pass (the bound), same order
-  std::vector<double> triad_median_bytes_per_second;      ///< median pass, same order
+  std::vector<int> triad_threads;                            ///< thread counts measured
+  std::vector<double> triad_bytes_per_second;                ///< best pass (the bound), same order
+  std::vector<double> triad_median_bytes_per_second;         ///< median pass, same order
   std::size_t triad_array_bytes = 0;
   std::string simd_build;  ///< e.g. "AVX2: 8 float / 4 double lanes"
   double load_average = -1;

@@ -211,10 +211,9 @@ std::string format_json(const Report& report) {
   s += "},\n";
   s += "  \"peer\": " + json_string(report.peer_status) + ",\n";
   s += "  \"machine\": {\"cpu\": " + json_string(m.cpu) +
-       ", \"hardware_threads\": " + std::to_string(m.hardware_threads) +
-       ", \"l1d_bytes\": " + json_bytes(m.l1d_bytes) + ", \"l2_bytes\": " + json_bytes(m.l2_bytes) +
-       ", \"l3_bytes\": " + json_bytes(m.l3_bytes) + ", \"simd\": " + json_string(m.simd_build) +
-       ", \"load_average\": " + json_number(m.load_average) +
+       ", \"hardware_threads\": " + std::to_string(m.hardware_threads) + ", \"l1d_bytes\": " + json_bytes(m.l1d_bytes) +
+       ", \"l2_bytes\": " + json_bytes(m.l2_bytes) + ", \"l3_bytes\": " + json_bytes(m.l3_bytes) +
+       ", \"simd\": " + json_string(m.simd_build) + ", \"load_average\": " + json_number(m.load_average) +
        ", \"triad_array_bytes\": " + std::to_string(m.triad_array_bytes) + ", \"triad_bytes_per_second\": {";
   for (std::size_t i = 0; i < m.triad_threads.size(); ++i) {
     s += (i ? ", " : "") + json_string(std::to_string(m.triad_threads[i])) + ": " +

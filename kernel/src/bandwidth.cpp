@@ -78,8 +78,8 @@ std::optional<std::size_t> cpuid_cache_bytes(int level) {
     // ECX[31:16] L2 KiB and EDX[31:18] L3 in 512 KiB units.
     if (__get_cpuid(0x80000000U, &eax, &ebx, &ecx, &edx) == 0) return std::nullopt;
     const unsigned max_ext = eax;
-    const bool topoext = max_ext >= 0x8000001DU && __get_cpuid(0x80000001U, &eax, &ebx, &ecx, &edx) != 0 &&
-                         (ecx & (1U << 22)) != 0;
+    const bool topoext =
+        max_ext >= 0x8000001DU && __get_cpuid(0x80000001U, &eax, &ebx, &ecx, &edx) != 0 && (ecx & (1U << 22)) != 0;
     if (!topoext) {
       std::size_t bytes = 0;
       if (level == 1 && max_ext >= 0x80000005U && __get_cpuid(0x80000005U, &eax, &ebx, &ecx, &edx) != 0) {

@@ -546,8 +546,8 @@ std::pair<std::string, std::string> broadphase_chain(float offset) {
                                ",0.12,0.25,0.2,1,0,0,0,"};
   const char* const motion[3] = {",1,0.5,0.7,3,-2,1\n", ",-0.5,0.2,0,0,4,-1\n", ",-1.5,1,0.2,-2,0,5\n"};
   for (int i = 0; i < 3; ++i) {
-    bodies += std::string(i == 1 ? "2" : "1") + rest[i] + num(p[i][0]) + "," + num(p[i][1]) + "," + num(p[i][2]) +
-              motion[i];
+    bodies +=
+        std::string(i == 1 ? "2" : "1") + rest[i] + num(p[i][0]) + "," + num(p[i][1]) + "," + num(p[i][2]) + motion[i];
   }
   std::string contacts = "a,b,cx,cy,cz,nx,ny,nz,e,mu\n";
   for (int b = 0; b < 2; ++b) {
@@ -589,8 +589,7 @@ TEST_F(CliTest, ForcedParticleRefusedWhereTheRotationMatters) {
   const RunResult f = solve(bodies, contacts, {"--precision", "float", "--model", "particle"});
   EXPECT_EQ(f.exit_code, 1);
   EXPECT_NE(f.err.find("--model particle does not fit the scene"), std::string::npos) << f.err;
-  EXPECT_NE(f.err.find("contact 0: the normal does not pass through the centre of body"), std::string::npos)
-      << f.err;
+  EXPECT_NE(f.err.find("contact 0: the normal does not pass through the centre of body"), std::string::npos) << f.err;
   EXPECT_TRUE(stray_files().empty());
 }
 

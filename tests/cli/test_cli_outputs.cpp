@@ -74,10 +74,10 @@ class OutputTargetTest : public ::testing::Test {
 
   RunResult solve(const std::string& out_bodies, const std::string& out_impulses,
                   const std::string& bodies = "bodies.csv") const {
-    return collide::test::run_program(COLLIDE_CLI_PATH, dir_,
-                                      {"solve", "--bodies", path(bodies).string(), "--contacts",
-                                       path("contacts.csv").string(), "--out-bodies", out_bodies, "--out-impulses",
-                                       out_impulses});
+    return collide::test::run_program(
+        COLLIDE_CLI_PATH, dir_,
+        {"solve", "--bodies", path(bodies).string(), "--contacts", path("contacts.csv").string(), "--out-bodies",
+         out_bodies, "--out-impulses", out_impulses});
   }
 
   /// The outputs of a solve into regular files: what every target must get.
@@ -140,8 +140,8 @@ TEST_F(OutputTargetTest, CharacterDeviceIsWrittenNotReplaced) {
 
   // --out-impulses DEVICE, and the device as the other output too.
   for (int which = 0; which < 2; ++which) {
-    const RunResult r = which == 0 ? solve(path("ob.csv").string(), node.string())
-                                   : solve(node.string(), path("oj.csv").string());
+    const RunResult r =
+        which == 0 ? solve(path("ob.csv").string(), node.string()) : solve(node.string(), path("oj.csv").string());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     struct stat after {};
     ASSERT_EQ(::lstat(node.c_str(), &after), 0);
@@ -218,10 +218,11 @@ TEST_F(OutputTargetTest, BadInputOpensNoDirectOutput) {
   // into its buffer without anyone reading.
   const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
   ASSERT_GE(fd, 0) << std::strerror(errno);
-  write_text(path("bad.csv"), "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
-                              "-2,0.8,0.8,0.8,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n"
-                              "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2\n"
-                              "inf,inf,inf,inf,1,0,0,0,0,-5,0,0,0,0,0,0,0\n");
+  write_text(path("bad.csv"),
+             "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
+             "-2,0.8,0.8,0.8,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n"
+             "1.5,0.2,0.6,0.6,1,0,0,0,0.8,2.2,0,-0.5,-4,0,0,0,-2\n"
+             "inf,inf,inf,inf,1,0,0,0,0,-5,0,0,0,0,0,0,0\n");
   const RunResult r = solve("-", fifo.string(), "bad.csv");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("bad.csv:2"), std::string::npos) << r.err;

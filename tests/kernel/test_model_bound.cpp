@@ -168,9 +168,8 @@ void expect_within_bound(const Scene<T>& scene, Model model) {
   EXPECT_LE(e.v, kImpulseErrorBoundEps) << to_string(model);
   EXPECT_LE(e.w, kImpulseErrorBoundEps) << to_string(model);
   EXPECT_GT(e.acting, scene.contacts.size() / 2);
-  std::printf("  %s %s: impulse %.3Lg, v %.3Lg, w %.3Lg units (bound %g), %zu of %zu contacts act\n",
-              type_name<T>(), to_string(model), e.impulse, e.v, e.w, kImpulseErrorBoundEps, e.acting,
-              scene.contacts.size());
+  std::printf("  %s %s: impulse %.3Lg, v %.3Lg, w %.3Lg units (bound %g), %zu of %zu contacts act\n", type_name<T>(),
+              to_string(model), e.impulse, e.v, e.w, kImpulseErrorBoundEps, e.acting, scene.contacts.size());
 }
 
 template <class T>
