@@ -87,6 +87,7 @@
 #include <utility>
 #include <vector>
 
+#include "collide/bandwidth.hpp"
 #include "collide/generate.hpp"
 #include "collide/model.hpp"
 #include "collide/scene.hpp"
