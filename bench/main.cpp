@@ -87,6 +87,7 @@
 #include <utility>
 #include <vector>
 
+#include "collide/bandwidth.hpp"
 #include "collide/generate.hpp"
 #include "collide/model.hpp"
 #include "collide/scene.hpp"
@@ -808,8 +809,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
   print("load average before/after: %.2f / %.2f on %u CPUs%s\n", load_before, load_average(),
         std::thread::hardware_concurrency(),
         load_before > 0.5 ? " -- other processes were running: expect noisy rows, try --benchmark_repetitions=3" : "");
-  print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20,
-        std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20) >> 20);
+  print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20, collide::default_triad_array_bytes() >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
   print("SIMD rows run %s (the best of this CPU: %s; isa/ rows run each ISA it has)\n",
         collide::to_string(collide::default_isa()), collide::to_string(collide::best_isa()));

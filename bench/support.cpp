@@ -65,7 +65,8 @@ void evict_caches() {
   benchmark::DoNotOptimize(sum);
 }
 
-std::size_t evict_buffer_bytes() { return 4 * llc_bytes(); }
+// The triad's size: 4 x LLC, capped by physical memory (a VM may report a huge L3).
+std::size_t evict_buffer_bytes() { return collide::default_triad_array_bytes(); }
 
 double triad_gbs(int threads) { return threads >= 1 && threads <= 2 ? g_triad[threads] : 0.0; }
 

@@ -46,8 +46,9 @@ constexpr std::size_t bytes_per_collision(bool friction) {
   return collide::bytes_per_collision(collide::Model::rigid, sizeof(T), friction);
 }
 
-/// Size of the last-level cache in bytes, from sysfs (the hypervisor's cpuid,
-/// which sysconf reads, may report the whole host's L3). 32 MiB if unknown.
+/// Size of the last-level cache in bytes: collide::last_level_cache_bytes()
+/// (/sys, else sysconf, else CPUID; a hypervisor may report the whole host's
+/// L3 through the last two). 32 MiB if unknown.
 std::size_t llc_bytes();
 
 /// A field of /proc/self/status ("VmRSS", "VmHWM") in bytes, or 0 if unknown.
@@ -57,7 +58,8 @@ double status_bytes(const char* field);
 /// to /proc/self/clear_refs. Returns false where the kernel does not allow it.
 bool reset_peak_rss();
 
-/// Streams a buffer of four times the last-level cache through the caches so
+/// Streams a buffer of the triad's array size (four times the last-level
+/// cache, capped by physical memory) through the caches so
 /// that none of a scene's lines is left in them, dirty lines included (their
 /// write-back happens here rather than inside the next timed solve).
 void evict_caches();

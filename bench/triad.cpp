@@ -25,7 +25,7 @@ namespace {
 void triad_benchmark(benchmark::State& state, int threads) {
   // The library's triad (collide/bandwidth.hpp), the one `collide report`
   // uses; here its passes are timed by the benchmark loop.
-  collide::TriadArrays triad(threads, std::max<std::size_t>(4 * llc_bytes(), std::size_t{128} << 20));
+  collide::TriadArrays triad(threads, collide::default_triad_array_bytes());
   double seconds = 0;
   for (auto _ : state) {
     const auto t0 = Clock::now();

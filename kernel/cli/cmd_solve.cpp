@@ -3,12 +3,17 @@
 // Design notes
 // ------------
 // * All input is read and validated before any output file is opened, and
-//   both outputs are written to temporaries that are renamed only when both
-//   are complete: bad input, or any failure, writes nothing and leaves
-//   pre-existing outputs untouched.
+//   regular outputs are written to temporaries that are renamed only when
+//   both are complete: bad input, or any failure, writes nothing and leaves
+//   pre-existing outputs untouched. An output that is stdout ("-"), a device
+//   or a FIFO is written in place (collide/output_file.hpp), after the
+//   temporaries and before their rename.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
 //   project reports as throughput; reading, scheduling and writing are timed
-//   separately.
+//   separately, and io_seconds (read + write) with io_fraction (its share of
+//   read + schedule + kernel + write) say how much of a run is file I/O: for
+//   large scenes nearly all of it (2M bodies: seconds of CSV against
+//   milliseconds of kernel).
 // * --check runs reference_solve<long double> on an exact copy of the inputs
 //   taken before the solve (convert_* copy without renormalising), and
 //   measures each impulse error in units of eps(T) * impulse_scale, the
@@ -53,8 +58,10 @@ const char* const kSolveUsage =
     "\n"
     "  --bodies FILE         bodies.csv: m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
     "  --contacts FILE       contacts.csv: a,b,cx,cy,cz,nx,ny,nz,e,mu\n"
-    "  --out-bodies FILE     result bodies file (replaced atomically)\n"
-    "  --out-impulses FILE   result impulses file (replaced atomically)\n"
+    "  --out-bodies FILE     result bodies file: a regular file is replaced\n"
+    "                        atomically; '-' (stdout), a device such as /dev/null\n"
+    "                        or a FIFO is written in place\n"
+    "  --out-impulses FILE   result impulses file, likewise (only one output may be '-')\n"
     "  --precision P         float or double (default double)\n"
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
@@ -68,7 +75,9 @@ const char* const kSolveUsage =
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
-    "  --stats               print one JSON object of statistics on stderr\n"
+    "  --stats               print one JSON object of statistics on stderr (kernel,\n"
+    "                        schedule, read and write times; io_fraction is the\n"
+    "                        share of file I/O, nearly all of a large scene's time)\n"
     "  --check               also run the long double reference and compare the\n"
     "                        impulses; exit 3 if an error exceeds the documented bound\n"
     "\n"
@@ -188,11 +197,23 @@ int solve_scene(const SolveRequest& req) {
   {
     OutputFile out_bodies(req.out_bodies_path);
     OutputFile out_impulses(req.out_impulses_path);
-    write_bodies(out_bodies, table, std::as_const(bodies).view());
-    write_impulses(out_impulses, std::as_const(impulses).view());
-    // Both complete: only now does either replace its destination.
-    out_bodies.commit();
-    out_impulses.commit();
+    const auto write = [&](OutputFile& out) {
+      if (&out == &out_bodies) {
+        write_bodies(out_bodies, table, std::as_const(bodies).view());
+      } else {
+        write_impulses(out_impulses, std::as_const(impulses).view());
+      }
+    };
+    // A direct output (stdout, device, FIFO) cannot be taken back: write it
+    // after the temporaries, and flush it before they are renamed, so that a
+    // failure anywhere still leaves every regular destination untouched.
+    const bool bodies_first = !out_bodies.direct() || out_impulses.direct();
+    OutputFile& first = bodies_first ? out_bodies : out_impulses;
+    OutputFile& second = bodies_first ? out_impulses : out_bodies;
+    write(first);
+    write(second);
+    second.commit();
+    first.commit();
   }
   const double write_seconds = seconds_since(t_write);
 
@@ -222,6 +243,11 @@ int solve_scene(const SolveRequest& req) {
     s += ", \"schedule_seconds\": " + json_number(schedule_seconds);
     s += ", \"read_seconds\": " + json_number(read_seconds);
     s += ", \"write_seconds\": " + json_number(write_seconds);
+    // File I/O against everything solve does: for large scenes the CSV text,
+    // not the kernel, is where the time goes (README, "Command line").
+    const double io_seconds = read_seconds + write_seconds;
+    s += ", \"io_seconds\": " + json_number(io_seconds);
+    s += ", \"io_fraction\": " + json_number(io_seconds / (io_seconds + schedule_seconds + kernel_seconds));
     if (req.check) {
       s += ", \"check\": true";
       s += ", \"max_impulse_error_eps\": " + json_number(check.max_error_eps);
@@ -274,7 +300,12 @@ int run_solve(int argc, char** argv) {
     std::error_code ec1, ec2;
     const auto a = std::filesystem::weakly_canonical(req.out_bodies_path, ec1);
     const auto b = std::filesystem::weakly_canonical(req.out_impulses_path, ec2);
-    if (req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b)) {
+    if (req.out_bodies_path == kStdoutPath && req.out_impulses_path == kStdoutPath) {
+      throw UsageError("only one of --out-bodies and --out-impulses can be '-' (stdout)");
+    }
+    // One character device (/dev/null) may take both: nothing is replaced.
+    const bool same = req.out_bodies_path == req.out_impulses_path || (!ec1 && !ec2 && a == b);
+    if (same && !std::filesystem::is_character_file(req.out_bodies_path, ec1)) {
       throw UsageError("--out-bodies and --out-impulses must be different files");
     }
   }

@@ -1,14 +1,23 @@
-// bandwidth.cpp - the triad bandwidth and the cache sizes of bandwidth.hpp.
+// bandwidth.cpp - the triad bandwidth and the cache sizes of bandwidth.hpp
+// (sources and order are stated there).
 //
 // The triad itself lives here once (TriadArrays): `collide report` takes the
 // best of its passes (measure_triad), bench/triad.cpp times its passes inside
 // Google Benchmark (mean over the iterations).
 #include "collide/bandwidth.hpp"
 
+#include <unistd.h>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
+#endif
+
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,23 +47,141 @@ std::size_t parse_size(const std::string& text) {
 
 }  // namespace
 
-std::size_t cache_bytes(int level) {
+const char* to_string(CacheSource source) {
+  switch (source) {
+    case CacheSource::sysfs:
+      return "sysfs";
+    case CacheSource::sysconf:
+      return "sysconf";
+    case CacheSource::cpuid:
+      return "cpuid";
+    case CacheSource::unknown:
+      break;
+  }
+  return "unknown";
+}
+
+std::optional<std::size_t> cpuid_cache_bytes(int level) {
+#if defined(__x86_64__) || defined(__i386__)
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (__get_cpuid(0, &eax, &ebx, &ecx, &edx) == 0) return std::nullopt;
+  const unsigned max_leaf = eax;
+  char vendor[13] = {};
+  std::memcpy(vendor, &ebx, 4);
+  std::memcpy(vendor + 4, &edx, 4);
+  std::memcpy(vendor + 8, &ecx, 4);
+  unsigned leaf = 0;
+  if (std::strcmp(vendor, "AuthenticAMD") == 0 || std::strcmp(vendor, "HygonGenuine") == 0) {
+    // 0x8000001D needs the topology extensions (0x80000001 ECX bit 22);
+    // hypervisors often hide them (this project's VM does), and then the
+    // legacy leaves say: 0x80000005 ECX[31:24] L1d KiB, 0x80000006
+    // ECX[31:16] L2 KiB and EDX[31:18] L3 in 512 KiB units.
+    if (__get_cpuid(0x80000000U, &eax, &ebx, &ecx, &edx) == 0) return std::nullopt;
+    const unsigned max_ext = eax;
+    const bool topoext =
+        max_ext >= 0x8000001DU && __get_cpuid(0x80000001U, &eax, &ebx, &ecx, &edx) != 0 && (ecx & (1U << 22)) != 0;
+    if (!topoext) {
+      std::size_t bytes = 0;
+      if (level == 1 && max_ext >= 0x80000005U && __get_cpuid(0x80000005U, &eax, &ebx, &ecx, &edx) != 0) {
+        bytes = std::size_t{ecx >> 24} << 10;
+      } else if ((level == 2 || level == 3) && max_ext >= 0x80000006U &&
+                 __get_cpuid(0x80000006U, &eax, &ebx, &ecx, &edx) != 0) {
+        bytes = level == 2 ? std::size_t{ecx >> 16} << 10 : std::size_t{edx >> 18} << 19;
+      }
+      if (bytes == 0) return std::nullopt;
+      return bytes;
+    }
+    leaf = 0x8000001DU;
+  } else if (std::strcmp(vendor, "GenuineIntel") == 0) {
+    if (max_leaf < 4) return std::nullopt;
+    leaf = 4;
+  } else {
+    return std::nullopt;
+  }
+  // Both leaves: EAX[4:0] type (0 none, 1 data, 2 instruction, 3 unified),
+  // EAX[7:5] level; size = ways x partitions x line x sets, each field + 1.
+  for (unsigned sub = 0; sub < 16; ++sub) {
+    __cpuid_count(leaf, sub, eax, ebx, ecx, edx);
+    const unsigned type = eax & 0x1FU;
+    if (type == 0) break;
+    if (static_cast<int>((eax >> 5) & 0x7U) != level || type == 2) continue;
+    const std::size_t ways = ((ebx >> 22) & 0x3FFU) + 1;
+    const std::size_t partitions = ((ebx >> 12) & 0x3FFU) + 1;
+    const std::size_t line = (ebx & 0xFFFU) + 1;
+    const std::size_t sets = std::size_t{ecx} + 1;
+    return ways * partitions * line * sets;
+  }
+#else
+  (void)level;
+#endif
+  return std::nullopt;
+}
+
+MachineProbe system_probe() {
+  MachineProbe p;
+  p.sysconf_cache_bytes = [](int level) -> long {
+    switch (level) {
+      case 1:
+        return ::sysconf(_SC_LEVEL1_DCACHE_SIZE);
+      case 2:
+        return ::sysconf(_SC_LEVEL2_CACHE_SIZE);
+      case 3:
+        return ::sysconf(_SC_LEVEL3_CACHE_SIZE);
+      case 4:
+        return ::sysconf(_SC_LEVEL4_CACHE_SIZE);
+      default:
+        return -1;
+    }
+  };
+  p.cpuid_cache_bytes = cpuid_cache_bytes;
+  p.physical_memory_bytes = []() -> std::optional<std::size_t> {
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page = ::sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || page <= 0) return std::nullopt;
+    return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
+  };
+  return p;
+}
+
+CacheSize cache_size(int level, const MachineProbe& probe) {
   for (int index = 0; index < 16; ++index) {
-    const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/";
+    const std::string dir = probe.sysfs_cache_dir + "/index" + std::to_string(index) + "/";
     std::ifstream level_file(dir + "level"), type_file(dir + "type"), size_file(dir + "size");
     int found_level = 0;
     std::string type, size;
     if (!(level_file >> found_level) || !(type_file >> type) || !(size_file >> size)) continue;
-    if (found_level == level && type != "Instruction") return parse_size(size);
+    if (found_level == level && type != "Instruction") {
+      if (const std::size_t bytes = parse_size(size); bytes != 0) return {bytes, CacheSource::sysfs};
+    }
   }
-  return 0;
+  if (probe.sysconf_cache_bytes) {
+    if (const long bytes = probe.sysconf_cache_bytes(level); bytes > 0) {
+      return {static_cast<std::size_t>(bytes), CacheSource::sysconf};
+    }
+  }
+  if (probe.cpuid_cache_bytes) {
+    if (const auto bytes = probe.cpuid_cache_bytes(level); bytes && *bytes != 0) return {bytes, CacheSource::cpuid};
+  }
+  return {};
 }
 
-std::size_t last_level_cache_bytes() {
+std::optional<std::size_t> cache_bytes(int level) { return cache_size(level).bytes; }
+
+std::size_t last_level_cache_bytes(const MachineProbe& probe) {
   for (int level = 4; level >= 1; --level) {
-    if (const std::size_t bytes = cache_bytes(level); bytes != 0) return bytes;
+    if (const CacheSize c = cache_size(level, probe); c.bytes) return *c.bytes;
   }
   return std::size_t{32} << 20;
+}
+
+std::size_t default_triad_array_bytes(const MachineProbe& probe) {
+  std::size_t bytes = std::max<std::size_t>(4 * last_level_cache_bytes(probe), std::size_t{128} << 20);
+  if (probe.physical_memory_bytes) {
+    if (const auto memory = probe.physical_memory_bytes(); memory && *memory > 0) {
+      bytes = std::min(bytes, *memory / 32);
+    }
+  }
+  return bytes;
 }
 
 struct TriadArrays::Impl {
@@ -82,7 +209,7 @@ struct TriadArrays::Impl {
 
 TriadArrays::TriadArrays(int threads, std::size_t array_bytes) {
   threads = std::max(1, threads);
-  if (array_bytes == 0) array_bytes = std::max<std::size_t>(4 * last_level_cache_bytes(), std::size_t{128} << 20);
+  if (array_bytes == 0) array_bytes = default_triad_array_bytes();
   impl_ = std::make_unique<Impl>(threads, array_bytes / sizeof(float));
   impl_->for_slices([&](std::size_t begin, std::size_t end) {
     std::fill(impl_->a.get() + begin, impl_->a.get() + end, 1.0f);

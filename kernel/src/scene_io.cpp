@@ -41,7 +41,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <limits>
 #include <memory>
 #include <system_error>
@@ -893,88 +892,6 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
     append_number(out, x);
   }
   out += '\n';
-}
-
-// ---------------------------------------------------------------------------
-// OutputFile
-// ---------------------------------------------------------------------------
-OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::is_directory(path_, ec)) throw SceneError(path_, "cannot write: is a directory");
-  const fs::path dest(path_);
-  const std::string dir = dest.parent_path().string();
-  // Same directory as the destination, so that rename() is atomic and never
-  // crosses a file system; hidden, so a crash leaves no plausible output.
-  std::string templ = (dir.empty() ? std::string() : dir + "/") + "." + dest.filename().string() + ".tmp-XXXXXX";
-  const int fd = ::mkstemp(templ.data());
-  if (fd < 0) {
-    throw SceneError(path_, "cannot create a temporary file in '" + (dir.empty() ? std::string(".") : dir) +
-                                "': " + std::strerror(errno));
-  }
-  temp_path_ = templ;
-  file_ = ::fdopen(fd, "wb");
-  if (file_ == nullptr) {
-    const int err = errno;
-    ::close(fd);
-    ::unlink(temp_path_.c_str());
-    throw SceneError(path_, std::string("cannot open a temporary file: ") + std::strerror(err));
-  }
-}
-
-OutputFile::~OutputFile() { discard(); }
-
-OutputFile::OutputFile(OutputFile&& other) noexcept
-    : path_(std::move(other.path_)),
-      temp_path_(std::move(other.temp_path_)),
-      file_(std::exchange(other.file_, nullptr)) {}
-
-OutputFile& OutputFile::operator=(OutputFile&& other) noexcept {
-  if (this != &other) {
-    discard();
-    path_ = std::move(other.path_);
-    temp_path_ = std::move(other.temp_path_);
-    file_ = std::exchange(other.file_, nullptr);
-  }
-  return *this;
-}
-
-void OutputFile::discard() noexcept {
-  if (file_ != nullptr) {
-    std::fclose(file_);
-    file_ = nullptr;
-    ::unlink(temp_path_.c_str());
-  }
-}
-
-void OutputFile::write(std::string_view bytes) {
-  if (file_ == nullptr) throw SceneError(path_, "write after commit");
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) {
-    const int err = errno;
-    discard();
-    throw SceneError(path_, std::string("write error: ") + std::strerror(err));
-  }
-}
-
-void OutputFile::commit() {
-  if (file_ == nullptr) throw SceneError(path_, "commit without an open file");
-  // mkstemp creates 0600; give the file the mode a plain fopen would.
-  const mode_t mask = ::umask(0);
-  ::umask(mask);
-  ::fchmod(::fileno(file_), 0666 & ~mask);
-  const bool flushed = std::fflush(file_) == 0 && !std::ferror(file_);
-  const int err = errno;
-  const bool closed = std::fclose(file_) == 0;
-  file_ = nullptr;
-  if (!flushed || !closed) {
-    ::unlink(temp_path_.c_str());
-    throw SceneError(path_, std::string("write error: ") + std::strerror(flushed ? errno : err));
-  }
-  if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
-    const int rerr = errno;
-    ::unlink(temp_path_.c_str());
-    throw SceneError(path_, std::string("cannot rename the temporary file into place: ") + std::strerror(rerr));
-  }
 }
 
 // ---------------------------------------------------------------------------

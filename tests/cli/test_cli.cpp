@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -461,6 +462,29 @@ TEST_F(CliTest, StatsIsOneJsonObjectWithTheDocumentedFields) {
   EXPECT_EQ(r.err.find("check"), std::string::npos) << "no check fields without --check";
 }
 
+/// The number after "key": in a one-line JSON object (NaN when absent).
+double stats_number(const std::string& json, const std::string& key) {
+  const std::size_t at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+TEST_F(CliTest, StatsSaysHowMuchIsFileIo) {
+  const RunResult r = solve(kBodies, kContacts, {"--stats"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double read = stats_number(r.err, "read_seconds");
+  const double write = stats_number(r.err, "write_seconds");
+  const double io = stats_number(r.err, "io_seconds");
+  const double fraction = stats_number(r.err, "io_fraction");
+  const double rest = stats_number(r.err, "schedule_seconds") + stats_number(r.err, "kernel_seconds");
+  ASSERT_TRUE(std::isfinite(io)) << r.err;
+  // Printed with 9 significant digits: equal to that precision.
+  EXPECT_NEAR(io, read + write, 1e-8 * io + 1e-12) << r.err;
+  EXPECT_NEAR(fraction, io / (io + rest), 1e-6) << r.err;
+  EXPECT_GT(fraction, 0);
+  EXPECT_LE(fraction, 1);
+}
+
 TEST_F(CliTest, StatsReportsCheck) {
   const RunResult r = solve(kBodies, kContacts, {"--stats", "--check"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -502,6 +526,71 @@ TEST_F(CliTest, SmallerModelsOnScenesThatFitThem) {
     EXPECT_NE(r.err.find("\"model\": \"sphere\""), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
   }
+}
+
+/// A chain of three touching spheres (radius 0.5) with unequal moments and
+/// spin, centred at `offset`, written as a broadphase in float writes it: n
+/// the centre difference normalised in float, c = pb + 0.5 n in float, every
+/// number printed to round trip. Returns {bodies, contacts}.
+std::pair<std::string, std::string> broadphase_chain(float offset) {
+  const float p[3][3] = {{offset + 0.1F, offset + 0.2F, offset + 0.3F},
+                         {offset + 0.1F + 0.577F, offset + 0.2F + 0.577F, offset + 0.3F + 0.576F},
+                         {offset + 0.1F + 0.577F + 0.8F, offset + 0.2F + 0.577F - 0.599F, offset + 0.3F + 0.576F}};
+  auto num = [](float x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(x));
+    return std::string(buf);
+  };
+  std::string bodies = "m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n";
+  const char* const rest[3] = {",0.1,0.2,0.3,0.5,0.5,0.5,0.5,", ",0.3,0.15,0.2,0.9238795,0,0,0.38268343,",
+                               ",0.12,0.25,0.2,1,0,0,0,"};
+  const char* const motion[3] = {",1,0.5,0.7,3,-2,1\n", ",-0.5,0.2,0,0,4,-1\n", ",-1.5,1,0.2,-2,0,5\n"};
+  for (int i = 0; i < 3; ++i) {
+    bodies +=
+        std::string(i == 1 ? "2" : "1") + rest[i] + num(p[i][0]) + "," + num(p[i][1]) + "," + num(p[i][2]) + motion[i];
+  }
+  std::string contacts = "a,b,cx,cy,cz,nx,ny,nz,e,mu\n";
+  for (int b = 0; b < 2; ++b) {
+    const int a = b + 1;
+    float d[3], n[3], c[3];
+    for (int i = 0; i < 3; ++i) d[i] = p[a][i] - p[b][i];
+    const float len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int i = 0; i < 3; ++i) n[i] = d[i] / len;
+    for (int i = 0; i < 3; ++i) c[i] = p[b][i] + 0.5F * n[i];
+    contacts += std::to_string(a) + "," + std::to_string(b) + "," + num(c[0]) + "," + num(c[1]) + "," + num(c[2]) +
+                "," + num(n[0]) + "," + num(n[1]) + "," + num(n[2]) + ",0.7,0\n";
+  }
+  return {bodies, contacts};
+}
+
+TEST_F(CliTest, AutoPicksParticleForABroadphaseScene) {
+  // Normals through both centres up to float rounding, bodies with moments
+  // and spin: the particle model is within the bound, and --check agrees.
+  const auto [bodies, contacts] = broadphase_chain(0.0F);
+  for (const char* model : {"auto", "particle"}) {
+    const RunResult r = solve(bodies, contacts, {"--precision", "float", "--model", model, "--stats", "--check"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("\"model\": \"particle\""), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(CliTest, ForcedParticleRefusedWhereTheRotationMatters) {
+  // The same chain 2000 radii from the origin: its float contact points miss
+  // the centres by over 300 eps (computed for this offset; how far depends on
+  // where the rounding of c falls); auto runs rigid, --model particle is
+  // refused naming the contact, and nothing is written.
+  const auto [bodies, contacts] = broadphase_chain(1000.0F);
+  const RunResult r = solve(bodies, contacts, {"--precision", "float", "--stats", "--check"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("\"model\": \"rigid\""), std::string::npos) << r.err;
+  fs::remove(path("ob.csv"));
+  fs::remove(path("oj.csv"));
+  const RunResult f = solve(bodies, contacts, {"--precision", "float", "--model", "particle"});
+  EXPECT_EQ(f.exit_code, 1);
+  EXPECT_NE(f.err.find("--model particle does not fit the scene"), std::string::npos) << f.err;
+  EXPECT_NE(f.err.find("contact 0: the normal does not pass through the centre of body"), std::string::npos) << f.err;
+  EXPECT_TRUE(stray_files().empty());
 }
 
 // ---------------------------------------------------------------------------

@@ -24,6 +24,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -32,8 +33,8 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/bandwidth.hpp"
 #include "collide/isa.hpp"
-
 #include "collide/error_bound.hpp"
 #include "support/run_cli.hpp"
 
@@ -237,6 +238,33 @@ TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
     if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0) ++lines;
   }
   EXPECT_EQ(lines, rows().size());
+}
+
+TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {
+  // Each cache size is the library's (/sys, else sysconf, else CPUID): a
+  // positive number, or null in JSON and "unknown" in the text - never 0.
+  ASSERT_TRUE(json_->has("machine")) << result_->err;
+  const Json& m = json_->at("machine");
+  const std::pair<const char*, int> caches[] = {{"l1d_bytes", 1}, {"l2_bytes", 2}, {"l3_bytes", 3}};
+  for (const auto& [key, level] : caches) {
+    ASSERT_TRUE(m.has(key)) << key;
+    const std::optional<std::size_t> known = collide::cache_bytes(level);
+    if (known) {
+      ASSERT_EQ(m.at(key).kind, Json::number) << key;
+      EXPECT_EQ(m.at(key).num, static_cast<double>(*known)) << key;
+    } else {
+      EXPECT_EQ(m.at(key).kind, Json::null) << key;
+    }
+  }
+  const std::size_t at = result_->out.find("machine: ");
+  ASSERT_NE(at, std::string::npos) << result_->out;
+  const std::string line = result_->out.substr(at, result_->out.find('\n', at) - at);
+  EXPECT_EQ(line.find(" 0 KiB"), std::string::npos) << line;
+  if (!collide::cache_bytes(1)) {
+    EXPECT_NE(line.find("L1d unknown"), std::string::npos) << line;
+  }
+  // The triad's arrays stay within memory whatever L3 the machine reports.
+  EXPECT_EQ(m.at("triad_array_bytes").num, static_cast<double>(collide::default_triad_array_bytes()));
 }
 
 TEST_F(ReportRun, JsonHoldsEveryVariant) {

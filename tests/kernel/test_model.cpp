@@ -3,8 +3,9 @@
 //
 // What this proves
 // ----------------
-// * choose_model() picks the cheapest model whose omitted terms are exactly
-//   zero: particle for bodies that cannot rotate and do not spin, particle
+// * choose_model() picks the cheapest model whose omitted terms are within
+//   the bound (here they are exactly zero; near-zero cases are in
+//   test_model_bound.cpp): particle for bodies that cannot rotate and do not spin, particle
 //   for frictionless contacts whose normals pass through both centres (even
 //   with spinning bodies), sphere for equal principal moments (whatever the
 //   orientation, immovable bodies' moments ignored), rigid otherwise; and

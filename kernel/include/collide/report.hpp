@@ -18,6 +18,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -70,10 +71,10 @@ struct SweepPoint {
 struct MachineInfo {
   std::string cpu;
   unsigned hardware_threads = 0;
-  std::size_t l1d_bytes = 0, l2_bytes = 0, l3_bytes = 0;  ///< one instance each
-  std::vector<int> triad_threads;                         ///< thread counts measured
-  std::vector<double> triad_bytes_per_second;             ///< best pass (the bound), same order
-  std::vector<double> triad_median_bytes_per_second;      ///< median pass, same order
+  std::optional<std::size_t> l1d_bytes, l2_bytes, l3_bytes;  ///< one instance each; nullopt = unknown
+  std::vector<int> triad_threads;                            ///< thread counts measured
+  std::vector<double> triad_bytes_per_second;                ///< best pass (the bound), same order
+  std::vector<double> triad_median_bytes_per_second;         ///< median pass, same order
   std::size_t triad_array_bytes = 0;
   std::string simd_build;  ///< e.g. "avx512 (of sse2, avx2, avx512): 16 float / 8 double lanes"
   double load_average = -1;

@@ -22,9 +22,9 @@
 //   order wins, so messages do not depend on threads.
 //   Writing formats blocks of rows in parallel with std::to_chars (shortest
 //   round trip: the text reads back to the same T) and writes them in order.
-// * Outputs go through OutputFile: a temporary file in the destination's
-//   directory, renamed over the destination by commit(). A failure, or an
-//   OutputFile destroyed without commit, leaves the destination untouched.
+// * Outputs go through OutputFile (collide/output_file.hpp): a temporary
+//   renamed over a regular destination by commit(), or a device, FIFO or
+//   stdout written directly.
 //
 // The header is C++17, like the rest of the public API.
 #pragma once
@@ -39,6 +39,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/output_file.hpp"
 
 namespace collide {
 
@@ -127,30 +128,6 @@ std::string read_file(const std::string& path);
 // ---------------------------------------------------------------------------
 // Writing.
 // ---------------------------------------------------------------------------
-
-/// A file written under a temporary name next to `path` and renamed onto
-/// `path` by commit(). Destroyed without commit, it removes the temporary
-/// and leaves `path` as it was. Not copyable; movable.
-class OutputFile {
- public:
-  explicit OutputFile(std::string path);
-  ~OutputFile();
-  OutputFile(const OutputFile&) = delete;
-  OutputFile& operator=(const OutputFile&) = delete;
-  OutputFile(OutputFile&& other) noexcept;
-  OutputFile& operator=(OutputFile&& other) noexcept;
-
-  void write(std::string_view bytes);
-  /// Flushes, closes and renames the temporary onto the destination.
-  void commit();
-  [[nodiscard]] const std::string& path() const { return path_; }
-
- private:
-  void discard() noexcept;
-  std::string path_;
-  std::string temp_path_;
-  std::FILE* file_ = nullptr;
-};
 
 /// Writes the result bodies file: every column of `inputs` except v and w,
 /// which come from `solved` (same body count). Use std::as_const(buffer).view().

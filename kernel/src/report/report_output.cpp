@@ -36,6 +36,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -82,6 +83,10 @@ std::string mib(std::size_t bytes) {
   if (bytes >= (std::size_t{1} << 20)) return format("%.0f MiB", static_cast<double>(bytes) / (1 << 20));
   return format("%.0f KiB", static_cast<double>(bytes) / 1024);
 }
+
+/// A cache size that may be unknown: "unknown" in text, null in JSON.
+std::string mib(const std::optional<std::size_t>& bytes) { return bytes ? mib(*bytes) : "unknown"; }
+std::string json_bytes(const std::optional<std::size_t>& bytes) { return bytes ? std::to_string(*bytes) : "null"; }
 
 int variant_rank(const std::string& v) {
   if (v == "reference") return 0;
@@ -208,10 +213,9 @@ std::string format_report_json(const Report& report) {
   s += "},\n";
   s += "  \"peer\": " + json_string(report.peer_status) + ",\n";
   s += "  \"machine\": {\"cpu\": " + json_string(m.cpu) +
-       ", \"hardware_threads\": " + std::to_string(m.hardware_threads) +
-       ", \"l1d_bytes\": " + std::to_string(m.l1d_bytes) + ", \"l2_bytes\": " + std::to_string(m.l2_bytes) +
-       ", \"l3_bytes\": " + std::to_string(m.l3_bytes) + ", \"simd\": " + json_string(m.simd_build) +
-       ", \"load_average\": " + json_number(m.load_average) +
+       ", \"hardware_threads\": " + std::to_string(m.hardware_threads) + ", \"l1d_bytes\": " + json_bytes(m.l1d_bytes) +
+       ", \"l2_bytes\": " + json_bytes(m.l2_bytes) + ", \"l3_bytes\": " + json_bytes(m.l3_bytes) +
+       ", \"simd\": " + json_string(m.simd_build) + ", \"load_average\": " + json_number(m.load_average) +
        ", \"triad_array_bytes\": " + std::to_string(m.triad_array_bytes) + ", \"triad_bytes_per_second\": {";
   for (std::size_t i = 0; i < m.triad_threads.size(); ++i) {
     s += (i ? ", " : "") + json_string(std::to_string(m.triad_threads[i])) + ": " +
@@ -442,8 +446,8 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
                " bandwidth bound (triad " + format("%.1f", triad / 1e9) + " GB/s / " + format("%.0f", bytes) + " B)'";
     }
     // Where the working set fills the L2 of the threads and the shared L3.
-    const double l2 = static_cast<double>(report.machine.l2_bytes) * max_threads / bytes;
-    const double l3 = static_cast<double>(report.machine.l3_bytes) / bytes;
+    const double l2 = static_cast<double>(report.machine.l2_bytes.value_or(0)) * max_threads / bytes;
+    const double l3 = static_cast<double>(report.machine.l3_bytes.value_or(0)) / bytes;
     for (const auto& [n, what] : {std::pair<double, std::string>{l2, "L2"}, {l3, "L3"}}) {
       if (n <= 0) continue;
       gp << "set arrow " << arrow++ << " from " << format("%.4e", n) << ", graph 0 to " << format("%.4e", n)
