@@ -46,7 +46,8 @@ __all__ = [
 __version__ = "0.1.0"
 
 
-def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", schedule=None, out=None):
+def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", schedule=None, out=None,
+          check=True):
     """Resolves every contact in place; returns ``(J, stats)``.
 
     ``bodies.v`` and ``bodies.w`` are updated; J (shape (3, M), the dtype of
@@ -59,9 +60,16 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     or "avx512"; ``accuracy`` "fast" or "accurate". For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
     solving. Bad input raises TypeError or ValueError and modifies nothing.
+
+    ``check=False`` skips the full validation of the values (a pass over every
+    array, about as long as the solve itself at 1M pairs) and the model-fit
+    check, for a frame loop re-solving a scene it validated once: indices and
+    array layouts are still checked (a bad index never reaches the kernel),
+    but NaN, a negative inverse mass or a non-unit normal then give the
+    law's garbage instead of an error.
     """
     solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy)
-    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out)
+    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, check=check)
 
 
 def reference_solve(bodies, contacts):

@@ -87,6 +87,7 @@ class Solver:
         model: ModelName = "auto",
         schedule: Schedule | None = None,
         out: FloatArray | None = None,
+        check: bool = True,
     ) -> tuple[FloatArray, dict[str, Any]]: ...
 
 class Reference:
@@ -110,6 +111,7 @@ def solve(
     accuracy: AccuracyName = "fast",
     schedule: Schedule | None = None,
     out: FloatArray | None = None,
+    check: bool = True,
 ) -> tuple[FloatArray, dict[str, Any]]: ...
 def reference_solve(bodies: Bodies, contacts: Contacts) -> Reference: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...

@@ -23,8 +23,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -110,11 +110,10 @@ py::array checked_array(const std::string& owner, const char* name, const py::ha
 
 std::size_t length(const py::array& a) { return static_cast<std::size_t>(a.shape(a.ndim() - 1)); }
 
-void require_length(const std::string& owner, const char* name, const py::array& a, std::size_t n,
-                    const char* first) {
+void require_length(const std::string& owner, const char* name, const py::array& a, std::size_t n, const char* first) {
   if (length(a) != n) {
-    throw py::value_error(owner + "." + name + " has " + std::to_string(length(a)) + " elements, " + first +
-                          " has " + std::to_string(n));
+    throw py::value_error(owner + "." + name + " has " + std::to_string(length(a)) + " elements, " + first + " has " +
+                          std::to_string(n));
   }
 }
 
@@ -144,8 +143,7 @@ struct Bodies {
          const py::object& p_in, const py::object& v_in, const py::object& w_in) {
     const std::string owner = "bodies";
     if (!py::isinstance<py::array>(inv_mass_in)) {
-      throw py::type_error("bodies.inv_mass must be a numpy.ndarray, got " +
-                           text(py::type::of(inv_mass_in)));
+      throw py::type_error("bodies.inv_mass must be a numpy.ndarray, got " + text(py::type::of(inv_mass_in)));
     }
     const py::dtype d = py::reinterpret_borrow<py::array>(inv_mass_in).dtype();
     if (d.equal(py::dtype::of<float>())) {
@@ -153,8 +151,7 @@ struct Bodies {
     } else if (d.equal(py::dtype::of<double>())) {
       dtype = Dtype::f64;
     } else {
-      throw py::type_error("bodies.inv_mass has dtype " + text(d) +
-                           ", expected float32 or float64");
+      throw py::type_error("bodies.inv_mass has dtype " + text(d) + ", expected float32 or float64");
     }
     const py::dtype dt = numpy_dtype(dtype);
     const char* dn = dtype_name(dtype);
@@ -178,8 +175,13 @@ struct Bodies {
   template <class T>
   BodyView<T> view() const {
     T* iq = data<T>(q);
-    return {count, data<T>(inv_mass), vec3<T>(inv_inertia), {iq, iq + count, iq + 2 * count, iq + 3 * count},
-            vec3<T>(p), vec3<T>(v), vec3<T>(w)};
+    return {count,
+            data<T>(inv_mass),
+            vec3<T>(inv_inertia),
+            {iq, iq + count, iq + 2 * count, iq + 3 * count},
+            vec3<T>(p),
+            vec3<T>(v),
+            vec3<T>(w)};
   }
 };
 
@@ -336,19 +338,25 @@ struct PySolver {
       : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy))) {}
 
   template <class T>
-  py::tuple solve_t(const Bodies& bodies, const Contacts& contacts, const std::string& model_name,
-                    PySchedule* schedule, const py::object& out) {
+  py::tuple solve_t(const Bodies& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
+                    const py::object& out, bool check) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
     T* jp = data<T>(j);
     const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
-    validate_or_throw<T>(bodies, contacts, jv);
     const BodyView<T> bv = bodies.view<T>();
     const ContactView<T> cv = contacts.view<T>();
+    if (check) {
+      validate_or_throw<T>(bodies, contacts, jv);
+    } else if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bv.count); !v) {
+      // Unchecked values are the caller's word; indices never are (memory safety).
+      throw py::value_error(v.message);
+    }
     Model model = Model::rigid;
     if (requested) {
       model = *requested;
-      if (const std::string misfit = model_misfit(model, bv, cv); !misfit.empty()) {
+      const std::string misfit = check ? model_misfit(model, bv, cv) : std::string();
+      if (!misfit.empty()) {
         throw py::value_error(std::string("model '") + to_string(model) + "' does not fit the scene: " + misfit);
       }
     } else {
@@ -373,14 +381,14 @@ struct PySolver {
     }
     const ImpulseView<const T> jc{jv.count, {jv.j.x, jv.j.y, jv.j.z}};
     return py::make_tuple(j, to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds,
-                                                    schedule == &own ? own.build_seconds : 0.0)));
+                                                     schedule == &own ? own.build_seconds : 0.0)));
   }
 
   py::tuple solve(const Bodies& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
-                  const py::object& out) {
+                  const py::object& out, bool check) {
     require_same_dtype(bodies, contacts);
-    return bodies.dtype == Dtype::f32 ? solve_t<float>(bodies, contacts, model, schedule, out)
-                                      : solve_t<double>(bodies, contacts, model, schedule, out);
+    return bodies.dtype == Dtype::f32 ? solve_t<float>(bodies, contacts, model, schedule, out, check)
+                                      : solve_t<double>(bodies, contacts, model, schedule, out, check);
   }
 };
 
@@ -396,7 +404,9 @@ struct Reference {
   BodyBuffer<long double> after;
   Dtype dtype = Dtype::f64;
 
-  py::array j_array() const { return ld_rows(impulses.view().j.x, impulses.view().j.y, impulses.view().j.z, impulses.size()); }
+  py::array j_array() const {
+    return ld_rows(impulses.view().j.x, impulses.view().j.y, impulses.view().j.z, impulses.size());
+  }
   py::array vec_array(bool angular) const {
     const BodyView<const long double> b = after.view();
     const Vec3Array<const long double> x = angular ? b.w : b.v;
@@ -433,7 +443,13 @@ std::shared_ptr<Reference> reference_t(const Bodies& bodies, const Contacts& con
   const ContactView<T> cv = contacts.view<T>();
   {
     py::gil_scoped_release release;
-    r->after = convert_bodies<long double>(BodyView<const T>{bv.count, bv.inv_mass, {bv.inv_inertia.x, bv.inv_inertia.y, bv.inv_inertia.z}, {bv.q.w, bv.q.x, bv.q.y, bv.q.z}, {bv.p.x, bv.p.y, bv.p.z}, {bv.v.x, bv.v.y, bv.v.z}, {bv.w.x, bv.w.y, bv.w.z}});
+    r->after = convert_bodies<long double>(BodyView<const T>{bv.count,
+                                                             bv.inv_mass,
+                                                             {bv.inv_inertia.x, bv.inv_inertia.y, bv.inv_inertia.z},
+                                                             {bv.q.w, bv.q.x, bv.q.y, bv.q.z},
+                                                             {bv.p.x, bv.p.y, bv.p.z},
+                                                             {bv.v.x, bv.v.y, bv.v.z},
+                                                             {bv.w.x, bv.w.y, bv.w.z}});
     const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
     r->impulses.resize(contacts.count);
     r->diagnostics.resize(contacts.count);
@@ -489,18 +505,18 @@ py::array copy_rows(Dtype d, std::initializer_list<const T*> rows, std::size_t n
 template <class T>
 py::tuple to_python(const BodyView<const T>& b, const ContactView<T>& c, Dtype d) {
   const std::size_t n = b.count, m = c.count;
-  py::object bodies = py::cast(Bodies(
-      copy_rows<T>(d, {b.inv_mass}, n), copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
-      copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
-      copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
+  py::object bodies = py::cast(
+      Bodies(copy_rows<T>(d, {b.inv_mass}, n), copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
+             copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
+             copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
   py::array_t<std::uint32_t> a(static_cast<py::ssize_t>(m)), bb(static_cast<py::ssize_t>(m));
   std::copy(c.a, c.a + m, a.mutable_data());
   std::copy(c.b, c.b + m, bb.mutable_data());
   py::object e = c.e ? py::object(copy_rows<T>(d, {c.e}, m)) : py::none();
   py::object mu = c.mu ? py::object(copy_rows<T>(d, {c.mu}, m)) : py::none();
-  py::object contacts = py::cast(Contacts(a, bb, copy_rows<T>(d, {c.c.x, c.c.y, c.c.z}, m),
-                                           copy_rows<T>(d, {c.n.x, c.n.y, c.n.z}, m), e,
-                                           static_cast<double>(c.uniform_e), mu));
+  py::object contacts =
+      py::cast(Contacts(a, bb, copy_rows<T>(d, {c.c.x, c.c.y, c.c.z}, m), copy_rows<T>(d, {c.n.x, c.n.y, c.n.z}, m), e,
+                        static_cast<double>(c.uniform_e), mu));
   return py::make_tuple(bodies, contacts);
 }
 
@@ -512,7 +528,8 @@ py::tuple scene_to_python(const Scene<T>& s, Dtype d) {
 py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
                       bool friction, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris") throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  if (kind != "pairs" && kind != "debris")
+    throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
   if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
   GenerateOptions o;
   o.seed = seed;
@@ -610,18 +627,14 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
   const py::array v = checked_array(owner, "v", v_in, dt, dn, 3, false);
   const py::array w = checked_array(owner, "w", w_in, dt, dn, 3, false);
   const std::size_t n = length(m);
-  for (const auto& [name, a] : {std::pair<const char*, const py::array*>{"inertia", &I},
-                                {"q", &q},
-                                {"p", &p},
-                                {"v", &v},
-                                {"w", &w}}) {
+  for (const auto& [name, a] :
+       {std::pair<const char*, const py::array*>{"inertia", &I}, {"q", &q}, {"p", &p}, {"v", &v}, {"w", &w}}) {
     require_length(owner, name, *a, n, "m");
   }
   auto run = [&](auto tag) {
     using T = decltype(tag);
     BodyBuffer<T> buffer(n);
-    const T *pm = data<T>(m), *pI = data<T>(I), *pq = data<T>(q), *pp = data<T>(p), *pv = data<T>(v),
-            *pw = data<T>(w);
+    const T *pm = data<T>(m), *pI = data<T>(I), *pq = data<T>(q), *pp = data<T>(p), *pv = data<T>(v), *pw = data<T>(w);
     for (std::size_t i = 0; i < n; ++i) {
       BodyRecord<T> r;
       r.m = pm[i];
@@ -650,10 +663,10 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
       buffer.set(i, r);
     }
     const BodyView<const T> b = std::as_const(buffer).view();
-    return py::cast(Bodies(
-        copy_rows<T>(d, {b.inv_mass}, n), copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
-        copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
-        copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
+    return py::cast(Bodies(copy_rows<T>(d, {b.inv_mass}, n),
+                           copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
+                           copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
+                           copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
   };
   return d == Dtype::f32 ? run(float{}) : run(double{});
 }
@@ -769,21 +782,21 @@ PYBIND11_MODULE(_collide, m) {
 
   py::class_<PySolver>(m, "Solver")
       .def(py::init<const std::string&, int, const py::object&, const std::string&>(), py::kw_only(),
-           py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
-           py::arg("accuracy") = "fast")
+           py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(), py::arg("accuracy") = "fast")
       .def_property_readonly("path", [](const PySolver& s) { return c::to_string(s.solver->options().path); })
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return c::to_string(s.solver->options().isa); })
       .def_property_readonly("accuracy", [](const PySolver& s) { return c::to_string(s.solver->options().accuracy); })
-      .def("solve", &PySolver::solve, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
-           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none());
+      .def("solve", &PySolver::solve, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("model") = "auto",
+           py::arg("schedule") = nullptr, py::arg("out") = py::none(), py::arg("check") = true);
 
   py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
       .def_property_readonly("J", &Reference::j_array)
       .def_property_readonly("v", [](const Reference& r) { return r.vec_array(false); })
       .def_property_readonly("w", [](const Reference& r) { return r.vec_array(true); })
-      .def_property_readonly("impulse_scale",
-                             [](const Reference& r) { return r.diag_array(&c::ReferenceContact<long double>::impulse_scale); })
+      .def_property_readonly(
+          "impulse_scale",
+          [](const Reference& r) { return r.diag_array(&c::ReferenceContact<long double>::impulse_scale); })
       .def_property_readonly("dtype", [](const Reference& r) { return numpy_dtype(r.dtype); })
       .def("__len__", [](const Reference& r) { return r.impulses.size(); });
 
@@ -791,26 +804,28 @@ PYBIND11_MODULE(_collide, m) {
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
         py::arg("model") = "rigid", py::arg("friction") = false, py::arg("dtype") = py::none());
-  m.def("read_scene", &read_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::kw_only(),
-        py::arg("dtype"));
+  m.def("read_scene", &read_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::kw_only(), py::arg("dtype"));
   m.def("write_scene", &write_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::arg("bodies"),
         py::arg("contacts"));
-  m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"),
-        py::arg("v"), py::arg("w"), py::arg("dtype"));
+  m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
+        py::arg("w"), py::arg("dtype"));
   m.def("report", &report_py, py::kw_only(), py::arg("n") = 4000000, py::arg("debris_n") = py::none(),
         py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000, py::arg("runs") = 5,
         py::arg("seed") = 1, py::arg("quick") = false);
   m.attr("error_bound_eps") = c::kImpulseErrorBoundEps;
-  m.def("simd_width", [](const std::string& isa, const py::object& dtype) {
-    const Dtype d = parse_dtype(dtype);
-    c::Isa i;
-    try {
-      i = c::resolve_isa(c::parse_isa(isa));
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(e.what());
-    }
-    return d == Dtype::f32 ? c::simd_width<float>(i) : c::simd_width<double>(i);
-  }, py::arg("isa") = "auto", py::arg("dtype"));
+  m.def(
+      "simd_width",
+      [](const std::string& isa, const py::object& dtype) {
+        const Dtype d = parse_dtype(dtype);
+        c::Isa i;
+        try {
+          i = c::resolve_isa(c::parse_isa(isa));
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+        return d == Dtype::f32 ? c::simd_width<float>(i) : c::simd_width<double>(i);
+      },
+      py::arg("isa") = "auto", py::arg("dtype"));
 
   py::register_exception_translator([](std::exception_ptr p) {
     try {
