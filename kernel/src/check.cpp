@@ -59,7 +59,11 @@ ImpulseCheck check_impulses(const ImpulseView<const T>& j, const ImpulseView<con
     const L dj = impulse_distance(j, ref, k);
     if (dj == L(0)) continue;
     const double err = static_cast<double>(normalised_impulse_error<T>(dj, diag[k]));
-    if (!(err <= r.max_error_eps)) {  // a NaN error is the worst
+    // A NaN error is the worst and stays the worst (the CLI's loop before
+    // this file let a later finite error replace it, so a NaN impulse could
+    // pass --check).
+    const bool worse = std::isnan(err) ? !std::isnan(r.max_error_eps) : err > r.max_error_eps;
+    if (worse && !std::isnan(r.max_error_eps)) {
       r.max_error_eps = err;
       r.worst_contact = k;
     }

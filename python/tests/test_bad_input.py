@@ -140,3 +140,24 @@ def test_bad_options():
         collide.generate("pairs", 10, dtype=np.int32)
     with pytest.raises(ValueError, match="kind"):
         collide.generate("cubes", 10)
+
+
+@pytest.mark.parametrize("kind", ["index", "self"])
+def test_unchecked_solve_still_checks_indices(kind):
+    arrays, carrays, message = corrupt(kind)
+    b, c = make(arrays, carrays)
+    before = {f: arrays[f].copy() for f in FIELDS}
+    with pytest.raises(ValueError, match=message):
+        collide.solve(b, c, model="rigid", check=False)
+    for f in FIELDS:
+        assert np.array_equal(arrays[f], before[f]), f
+
+
+def test_unchecked_solve_is_the_same_solve():
+    bodies, contacts = collide.generate("debris", 3000, friction=True, dtype=np.float32)
+    v0, w0 = bodies.v.copy(), bodies.w.copy()
+    J1, _ = collide.solve(bodies, contacts)
+    np.copyto(bodies.v, v0)
+    np.copyto(bodies.w, w0)
+    J2, _ = collide.solve(bodies, contacts, model="rigid", check=False)
+    assert np.array_equal(J1, J2)
