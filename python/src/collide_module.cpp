@@ -11,6 +11,9 @@
 // * Values are checked by the library's validate() (ValueError naming the
 //   array and the first bad element) before anything is written, so bad input
 //   modifies nothing. Whether a scene fits a model is model_misfit()'s.
+// * check=False (Solver.solve) skips validate() and the model-fit check for
+//   frame loops that validated their scene once; validate_indices() still
+//   runs, so no index outside the arrays ever reaches the kernel.
 // * The GIL is released around every long C++ call (solve, reference,
 //   report, generate, file I/O). The ndarrays stay referenced by the Bodies
 //   and Contacts objects (and the call's arguments) meanwhile.
@@ -128,6 +131,17 @@ Vec3Array<T> vec3(const py::array& a) {
   return {p, p + n, p + 2 * n};
 }
 
+/// The dtype of a scene, from its first floating-point array `what`.
+Dtype scene_dtype(const std::string& what, const py::handle& obj) {
+  if (!py::isinstance<py::array>(obj)) {
+    throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
+  }
+  const py::dtype d = py::reinterpret_borrow<py::array>(obj).dtype();
+  if (d.equal(py::dtype::of<float>())) return Dtype::f32;
+  if (d.equal(py::dtype::of<double>())) return Dtype::f64;
+  throw py::type_error(what + " has dtype " + text(d) + ", expected float32 or float64");
+}
+
 py::array new_array(Dtype d, std::vector<py::ssize_t> shape) { return py::array(numpy_dtype(d), std::move(shape)); }
 
 // ---------------------------------------------------------------------------
@@ -142,17 +156,7 @@ struct Bodies {
   Bodies(const py::object& inv_mass_in, const py::object& inv_inertia_in, const py::object& q_in,
          const py::object& p_in, const py::object& v_in, const py::object& w_in) {
     const std::string owner = "bodies";
-    if (!py::isinstance<py::array>(inv_mass_in)) {
-      throw py::type_error("bodies.inv_mass must be a numpy.ndarray, got " + text(py::type::of(inv_mass_in)));
-    }
-    const py::dtype d = py::reinterpret_borrow<py::array>(inv_mass_in).dtype();
-    if (d.equal(py::dtype::of<float>())) {
-      dtype = Dtype::f32;
-    } else if (d.equal(py::dtype::of<double>())) {
-      dtype = Dtype::f64;
-    } else {
-      throw py::type_error("bodies.inv_mass has dtype " + text(d) + ", expected float32 or float64");
-    }
+    dtype = scene_dtype("bodies.inv_mass", inv_mass_in);
     const py::dtype dt = numpy_dtype(dtype);
     const char* dn = dtype_name(dtype);
     inv_mass = checked_array(owner, "inv_mass", inv_mass_in, dt, dn, 0, false);
@@ -198,17 +202,7 @@ struct Contacts {
     const py::dtype u32 = py::dtype::of<std::uint32_t>();
     a = checked_array(owner, "a", a_in, u32, "uint32", 0, false);
     b = checked_array(owner, "b", b_in, u32, "uint32", 0, false);
-    if (!py::isinstance<py::array>(c_in)) {
-      throw py::type_error("contacts.c must be a numpy.ndarray, got " + text(py::type::of(c_in)));
-    }
-    const py::dtype d = py::reinterpret_borrow<py::array>(c_in).dtype();
-    if (d.equal(py::dtype::of<float>())) {
-      dtype = Dtype::f32;
-    } else if (d.equal(py::dtype::of<double>())) {
-      dtype = Dtype::f64;
-    } else {
-      throw py::type_error("contacts.c has dtype " + text(d) + ", expected float32 or float64");
-    }
+    dtype = scene_dtype("contacts.c", c_in);
     const py::dtype dt = numpy_dtype(dtype);
     const char* dn = dtype_name(dtype);
     c = checked_array(owner, "c", c_in, dt, dn, 3, false);
@@ -477,9 +471,7 @@ py::array impulse_error_t(const py::array& j, const Reference& ref) {
 }
 
 py::array impulse_error_py(const py::object& j_in, const Reference& ref) {
-  if (!py::isinstance<py::array>(j_in)) throw py::type_error("J must be a numpy.ndarray");
-  const py::dtype d = py::reinterpret_borrow<py::array>(j_in).dtype();
-  const Dtype dtype = d.equal(py::dtype::of<float>()) ? Dtype::f32 : Dtype::f64;
+  const Dtype dtype = scene_dtype("impulse_error.J", j_in);
   const py::array j = checked_array("impulse_error", "J", j_in, numpy_dtype(dtype), "float32 or float64", 3, false);
   require_length("impulse_error", "J", j, ref.impulses.size(), "the reference");
   return dtype == Dtype::f32 ? impulse_error_t<float>(j, ref) : impulse_error_t<double>(j, ref);
