@@ -5,10 +5,14 @@ set -euo pipefail
 
 # gnuplot-nox draws the report's plot and the debris example's picture;
 # libbullet-dev gives `collide report` its peer row (optional in CMake).
+# pybind11-dev and the python3-* packages: the Python extension (python/), its
+# tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
+# no network (venv, setuptools, pip).
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
 # scripts/ci-sanitizers.sh.
 packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
-  clang-14 libclang-rt-14-dev)
+  clang-14 libclang-rt-14-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -35,6 +35,7 @@
 
 #include <oneapi/tbb/global_control.h>
 
+#include "collide/check.hpp"
 #include "collide/error_bound.hpp"
 #include "collide/model.hpp"
 #include "collide/reference.hpp"
@@ -90,14 +91,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
-/// A JSON number; JSON has no inf or NaN, so those become null.
-std::string json_number(double x) {
-  if (!std::isfinite(x)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", x);
-  return buf;
-}
-
 struct SolveRequest {
   std::string bodies_path, contacts_path, out_bodies_path, out_impulses_path;
   bool want_float = false;
@@ -110,37 +103,6 @@ struct SolveRequest {
   bool stats = false;
   bool check = false;
 };
-
-struct CheckResult {
-  double max_error_eps = 0;       // max |J - Jref| / (eps * impulse_scale)
-  double max_relative_error = 0;  // max |J - Jref| / |Jref| over |Jref| > 0
-  std::size_t worst_contact = 0;
-  bool passed = true;
-};
-
-/// Compares the kernel's impulses with the long double reference.
-template <class T>
-CheckResult check_impulses(const ImpulseView<const T>& j, const ImpulseView<long double>& ref,
-                           const std::vector<ReferenceContact<long double>>& diag) {
-  using L = long double;
-  CheckResult r;
-  for (std::size_t k = 0; k < j.count; ++k) {
-    const L dx = L(j.j.x[k]) - ref.j.x[k];
-    const L dy = L(j.j.y[k]) - ref.j.y[k];
-    const L dz = L(j.j.z[k]) - ref.j.z[k];
-    const L dj = std::sqrt(dx * dx + dy * dy + dz * dz);
-    if (dj == L(0)) continue;
-    const double err = static_cast<double>(normalised_impulse_error<T>(dj, diag[k]));
-    if (!(err <= r.max_error_eps)) {
-      r.max_error_eps = err;
-      r.worst_contact = k;
-    }
-    const L jref = std::sqrt(ref.j.x[k] * ref.j.x[k] + ref.j.y[k] * ref.j.y[k] + ref.j.z[k] * ref.j.z[k]);
-    if (jref > L(0)) r.max_relative_error = std::max(r.max_relative_error, static_cast<double>(dj / jref));
-  }
-  r.passed = r.max_error_eps <= kImpulseErrorBoundEps;
-  return r;
-}
 
 template <class T>
 int solve_scene(const SolveRequest& req) {
@@ -182,14 +144,14 @@ int solve_scene(const SolveRequest& req) {
   const SolveStats stats = solver.solve(model, bodies.view(), contacts.view(), impulses.view(), schedule);
   const double kernel_seconds = seconds_since(t_kernel);
 
-  CheckResult check;
+  ImpulseCheck check;
   double check_seconds = 0;
   if (req.check) {
     const auto t_check = Clock::now();
     ImpulseBuffer<long double> ref_impulses(contacts.size());
     std::vector<ReferenceContact<long double>> diag(contacts.size());
     reference_solve<long double>(ref_bodies.view(), ref_contacts.view(), ref_impulses.view(), diag.data());
-    check = check_impulses<T>(std::as_const(impulses).view(), ref_impulses.view(), diag);
+    check = check_impulses<T>(std::as_const(impulses).view(), std::as_const(ref_impulses).view(), diag);
     check_seconds = seconds_since(t_check);
   }
 
@@ -218,47 +180,17 @@ int solve_scene(const SolveRequest& req) {
   const double write_seconds = seconds_since(t_write);
 
   if (req.stats) {
-    std::size_t impacts = 0;
-    const ImpulseView<const T> j = std::as_const(impulses).view();
-    for (std::size_t k = 0; k < j.count; ++k) {
-      impacts += (j.j.x[k] != T(0) || j.j.y[k] != T(0) || j.j.z[k] != T(0)) ? 1 : 0;
-    }
-    std::string s = "{";
-    s += "\"collisions\": " + std::to_string(stats.contacts);
-    s += ", \"impacts\": " + std::to_string(impacts);
-    s += ", \"bodies\": " + std::to_string(table.size());
-    s += ", \"kernel_seconds\": " + json_number(kernel_seconds);
-    s += ", \"collisions_per_second\": " + json_number(kernel_seconds > 0
-                                                           ? static_cast<double>(stats.contacts) / kernel_seconds
-                                                           : std::numeric_limits<double>::infinity());
-    s += std::string(", \"precision\": \"") + (req.want_float ? "float" : "double") + "\"";
-    s += ", \"threads\": " + std::to_string(stats.threads);
-    s += std::string(", \"model\": \"") + to_string(stats.model) + "\"";
-    s += std::string(", \"path\": \"") + to_string(stats.path) + "\"";
-    s += std::string(", \"isa\": \"") + to_string(stats.isa) + "\"";
-    s += std::string(", \"layout\": \"") + to_string(stats.layout) + "\"";
-    s += ", \"lanes\": " + std::to_string(stats.lanes);
-    s += ", \"batches\": " + std::to_string(stats.batches);
-    s += ", \"largest_batch\": " + std::to_string(schedule.largest_batch());
-    s += ", \"schedule_seconds\": " + json_number(schedule_seconds);
-    s += ", \"read_seconds\": " + json_number(read_seconds);
-    s += ", \"write_seconds\": " + json_number(write_seconds);
+    StatRecord record =
+        solve_record<T>(stats, std::as_const(impulses).view(), table.size(), kernel_seconds, schedule_seconds);
+    record.emplace_back("read_seconds", read_seconds);
+    record.emplace_back("write_seconds", write_seconds);
     // File I/O against everything solve does: for large scenes the CSV text,
     // not the kernel, is where the time goes (README, "Command line").
     const double io_seconds = read_seconds + write_seconds;
-    s += ", \"io_seconds\": " + json_number(io_seconds);
-    s += ", \"io_fraction\": " + json_number(io_seconds / (io_seconds + schedule_seconds + kernel_seconds));
-    if (req.check) {
-      s += ", \"check\": true";
-      s += ", \"max_impulse_error_eps\": " + json_number(check.max_error_eps);
-      s += ", \"max_relative_error\": " + json_number(check.max_relative_error);
-      s += ", \"worst_contact\": " + std::to_string(check.worst_contact);
-      s += ", \"error_bound_eps\": " + json_number(kImpulseErrorBoundEps);
-      s += std::string(", \"check_passed\": ") + (check.passed ? "true" : "false");
-      s += ", \"check_seconds\": " + json_number(check_seconds);
-    }
-    s += "}\n";
-    std::fputs(s.c_str(), stderr);
+    record.emplace_back("io_seconds", io_seconds);
+    record.emplace_back("io_fraction", io_seconds / (io_seconds + schedule_seconds + kernel_seconds));
+    if (req.check) add_check(record, check, check_seconds);
+    std::fputs((to_json(record) + "\n").c_str(), stderr);
   }
   if (!check.passed) {
     std::fprintf(stderr,

@@ -161,6 +161,18 @@ Validation validate(const ParticleView<T>& bodies, const ContactView<T>& contact
   return validate_any<T>(bodies, contacts, impulses, false);
 }
 
+Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count) {
+  for (std::size_t k = 0; k < count; ++k) {
+    // One branch per contact on the common path: all three checks at once.
+    if (a[k] < body_count && b[k] < body_count && a[k] != b[k]) continue;
+    const std::string range = "out of range (" + std::to_string(body_count) + " bodies)";
+    if (a[k] >= body_count) return fail("contacts", "a", k, a[k], range.c_str());
+    if (b[k] >= body_count) return fail("contacts", "b", k, b[k], range.c_str());
+    return fail("contacts", "b", k, b[k], "a contact of a body with itself");
+  }
+  return {};
+}
+
 #define COLLIDE_INSTANTIATE(T)                                                                         \
   template Validation validate<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&);   \
   template Validation validate<T>(const SphereView<T>&, const ContactView<T>&, const ImpulseView<T>&); \

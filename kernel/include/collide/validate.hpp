@@ -39,4 +39,10 @@ Validation validate(const SphereView<T>& bodies, const ContactView<T>& contacts,
 template <class T>
 Validation validate(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
 
+/// Only what keeps a solve inside the arrays: every index of `a` and `b`
+/// below `body_count`, and a != b. O(count), for callers that vouch for the
+/// values (a frame loop re-solving a scene it validated once: the Python
+/// module's check=False); the message names the element like validate()'s.
+Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count);
+
 }  // namespace collide

@@ -569,8 +569,9 @@ Report measure_report(const ReportOptions& options) {
   require(options.runs >= 1 && options.runs <= 1000, "runs must be from 1 to 1000");
   require(!options.threads.empty(), "threads needs at least one count");
   for (const int t : options.threads) require(t >= 1 && t <= 4096, "thread counts must be from 1 to 4096");
-  for (const std::size_t n : options.sweep_n)
+  for (const std::size_t n : options.sweep_n) {
     require(n >= 1 && n <= 0x7FFFFFFFULL, "sweep sizes must be from 1 to 2^31 - 1");
+  }
   const auto t0 = Clock::now();
   Report report;
   report.n = options.n;

@@ -1,0 +1,152 @@
+"""collide: batched rigid-body collision impulses on NumPy arrays, in place.
+
+The arrays are structure-of-arrays: ``inv_mass`` has shape (N,), every
+vector array has shape (3, N) (row k is component k) and ``q`` has shape
+(4, N) as (w, x, y, z). One dtype per scene, float32 or float64, C-contiguous.
+Nothing is copied: :func:`solve` updates ``bodies.v`` and ``bodies.w`` of
+the caller's arrays and returns the impulses J, shape (3, M).
+
+Typical use::
+
+    import collide
+    bodies, contacts = collide.generate("pairs", 1_000_000, dtype=numpy.float32)
+    ref = collide.reference_solve(bodies, contacts)   # before: it copies the inputs
+    J, stats = collide.solve(bodies, contacts)
+    err = collide.impulse_error(J, ref)               # eps * impulse_scale units
+
+The law, the error measure and the bound (``error_bound_eps``) are those of
+``collide solve --check``; docs/python.md describes the API.
+"""
+
+from __future__ import annotations
+
+import numpy as _np
+
+from . import _collide
+from ._collide import Bodies, Contacts, Reference, Schedule, Solver, error_bound_eps
+
+__all__ = [
+    "Bodies",
+    "Contacts",
+    "Reference",
+    "Schedule",
+    "Solver",
+    "error_bound_eps",
+    "from_physical",
+    "generate",
+    "impulse_error",
+    "read_scene",
+    "reference_solve",
+    "report",
+    "best_isa",
+    "isa_supported",
+    "simd_width",
+    "solve",
+    "write_scene",
+]
+
+__version__ = "0.1.0"
+
+
+def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", schedule=None, out=None,
+          check=True):
+    """Resolves every contact in place; returns ``(J, stats)``.
+
+    ``bodies.v`` and ``bodies.w`` are updated; J (shape (3, M), the dtype of
+    the scene) is the impulse on body a of each contact. ``stats`` has the keys
+    of ``collide solve --stats`` (collisions, impacts, bodies, kernel_seconds,
+    collisions_per_second, precision, threads, model, path, isa, accuracy,
+    lanes, batches, largest_batch, schedule_seconds). ``model`` is "auto" (the
+    cheapest that fits), "rigid", "sphere" or "particle"; ``path`` "simd" or
+    "scalar"; ``threads`` 0 for all; ``isa`` None (automatic), "sse2", "avx2"
+    or "avx512"; ``accuracy`` "fast" or "accurate". For frame loops build a
+    :class:`Solver` and a :class:`Schedule` once. The GIL is released while
+    solving. Bad input raises TypeError or ValueError and modifies nothing.
+
+    ``check=False`` skips the full validation of the values (a pass over every
+    array, about as long as the solve itself at 1M pairs) and the model-fit
+    check, for a frame loop re-solving a scene it validated once: indices and
+    array layouts are still checked (a bad index never reaches the kernel),
+    but NaN, a negative inverse mass or a non-unit normal then give the
+    law's garbage instead of an error.
+    """
+    solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy)
+    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, check=check)
+
+
+def reference_solve(bodies, contacts):
+    """The high-precision reference (long double) on an exact copy of the inputs.
+
+    The caller's bodies are not modified. Returns a :class:`Reference` with
+    ``J`` (float64 (3, M)), the bodies' ``v`` and ``w`` after it, and
+    ``impulse_scale`` per contact. Call it before :func:`solve` (which
+    updates the velocities) to compare the two with :func:`impulse_error`.
+    """
+    return _collide.reference_solve(bodies, contacts)
+
+
+def impulse_error(J, reference):
+    """Per-contact error of J against the reference, float64 (M,), in units of
+    eps(J.dtype) * impulse_scale (what ``collide solve --check`` bounds by
+    ``error_bound_eps``). NaN for a NaN impulse."""
+    return _collide.impulse_error(J, reference)
+
+
+def generate(kind, n, *, seed=1, model="rigid", friction=False, dtype=_np.float32):
+    """The scenes of ``collide gen``: ``kind`` "pairs" (n independent pairs,
+    2n bodies) or "debris" (n contacts on shared bodies). Returns
+    ``(Bodies, Contacts)`` over new arrays."""
+    return _collide.generate(kind, n, seed=seed, model=model, friction=friction, dtype=dtype)
+
+
+def read_scene(bodies_csv, contacts_csv, dtype=_np.float64):
+    """Reads a scene in the files of ``collide solve`` (physical units) and
+    returns ``(Bodies, Contacts)`` with the inverses the solver takes. A bad
+    file raises ValueError naming file, line, row and column."""
+    return _collide.read_scene(str(bodies_csv), str(contacts_csv), dtype=dtype)
+
+
+def write_scene(bodies_csv, contacts_csv, bodies, contacts):
+    """Writes the scene in the file format (masses and moments as 1/inverse,
+    inf for 0). Both files are replaced atomically, or neither."""
+    _collide.write_scene(str(bodies_csv), str(contacts_csv), bodies, contacts)
+
+
+def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
+    """Bodies from physical units: mass m (N,) (inf = immovable), principal
+    moments ``inertia`` (3, N) (inf = no rotation about that axis), any
+    non-zero quaternion q (4, N) (normalised), p, v, w (3, N); v and w default
+    to zero. Array-likes are converted to ``dtype``; the result owns new arrays."""
+    dt = _np.dtype(dtype)
+
+    def arr(x, rows):
+        if x is None:
+            return _np.zeros((rows, len(_np.asarray(m))), dtype=dt)
+        return _np.ascontiguousarray(x, dtype=dt)
+
+    return _collide.from_physical(arr(m, 0), arr(inertia, 3), arr(q, 4), arr(p, 3), arr(v, 3), arr(w, 3), dt)
+
+
+def report(*, n=4_000_000, debris_n=None, threads=(1, 2), sample=100_000, runs=5, seed=1, quick=False):
+    """The rows of ``collide report`` as a list of dicts (speed and error of
+    every variant on the pairs and debris scenes; docs/report.md has the
+    columns). Takes minutes with the defaults; ``quick=True`` for a smoke run."""
+    return _collide.report(n=n, debris_n=debris_n, threads=list(threads), sample=sample, runs=runs, seed=seed,
+                           quick=quick)
+
+
+def isa_supported(isa):
+    """True when this CPU (and this build) can run ``isa``: "sse2", "avx2",
+    "avx512" or "auto". ValueError for another name."""
+    return _collide.isa_supported(isa)
+
+
+def best_isa():
+    """The widest instruction set this CPU and build support (what "auto" is
+    when COLLIDE_ISA is not set)."""
+    return _collide.best_isa()
+
+
+def simd_width(isa="auto", dtype=_np.float32):
+    """Lanes of the SIMD path for ``isa`` (resolved as the solver does) and dtype."""
+    return _collide.simd_width(isa, dtype)

@@ -1,0 +1,151 @@
+"""Type stubs of the collide package (see __init__.py and docs/python.md)."""
+
+from typing import Any, Literal, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+Float = np.float32 | np.float64
+FloatArray = npt.NDArray[np.float32] | npt.NDArray[np.float64]
+ModelName = Literal["auto", "rigid", "sphere", "particle"]
+PathName = Literal["simd", "scalar"]
+IsaName = Literal["auto", "sse2", "avx2", "avx512"]
+AccuracyName = Literal["fast", "accurate"]
+
+__version__: str
+error_bound_eps: float
+
+class Bodies:
+    """N bodies over the caller's arrays (no copy): inv_mass (N,), inv_inertia,
+    p, v, w (3, N), q (4, N) as (w, x, y, z); one dtype, C-contiguous."""
+
+    inv_mass: FloatArray
+    inv_inertia: FloatArray
+    q: FloatArray
+    p: FloatArray
+    v: FloatArray
+    w: FloatArray
+    dtype: np.dtype[Any]
+    def __init__(
+        self,
+        inv_mass: FloatArray,
+        inv_inertia: FloatArray,
+        q: FloatArray,
+        p: FloatArray,
+        v: FloatArray,
+        w: FloatArray,
+    ) -> None: ...
+    def __len__(self) -> int: ...
+
+class Contacts:
+    """M contacts: a, b uint32 (M,), c, n (3, M), e and mu (M,) or None."""
+
+    a: npt.NDArray[np.uint32]
+    b: npt.NDArray[np.uint32]
+    c: FloatArray
+    n: FloatArray
+    e: FloatArray | None
+    mu: FloatArray | None
+    uniform_e: float
+    dtype: np.dtype[Any]
+    def __init__(
+        self,
+        a: npt.NDArray[np.uint32],
+        b: npt.NDArray[np.uint32],
+        c: FloatArray,
+        n: FloatArray,
+        e: FloatArray | None = None,
+        uniform_e: float = 1.0,
+        mu: FloatArray | None = None,
+    ) -> None: ...
+    def __len__(self) -> int: ...
+
+class Schedule:
+    """The batches of a contact set; reusable while indices and inverse masses stay."""
+
+    batches: int
+    largest_batch: int
+    build_seconds: float
+    def __init__(self, bodies: Bodies, contacts: Contacts) -> None: ...
+
+class Solver:
+    """A reusable solver (its thread arena and options) for frame loops."""
+
+    def __init__(
+        self,
+        *,
+        path: PathName = "simd",
+        threads: int = 0,
+        isa: IsaName | None = None,
+        accuracy: AccuracyName = "fast",
+    ) -> None: ...
+    def solve(
+        self,
+        bodies: Bodies,
+        contacts: Contacts,
+        *,
+        model: ModelName = "auto",
+        schedule: Schedule | None = None,
+        out: FloatArray | None = None,
+        check: bool = True,
+    ) -> tuple[FloatArray, dict[str, Any]]: ...
+
+class Reference:
+    """The long double reference of one scene (values rounded to float64)."""
+
+    J: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    w: npt.NDArray[np.float64]
+    impulse_scale: npt.NDArray[np.float64]
+    dtype: np.dtype[Any]
+    def __len__(self) -> int: ...
+
+def solve(
+    bodies: Bodies,
+    contacts: Contacts,
+    *,
+    model: ModelName = "auto",
+    path: PathName = "simd",
+    threads: int = 0,
+    isa: IsaName | None = None,
+    accuracy: AccuracyName = "fast",
+    schedule: Schedule | None = None,
+    out: FloatArray | None = None,
+    check: bool = True,
+) -> tuple[FloatArray, dict[str, Any]]: ...
+def reference_solve(bodies: Bodies, contacts: Contacts) -> Reference: ...
+def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
+def generate(
+    kind: Literal["pairs", "debris"],
+    n: int,
+    *,
+    seed: int = 1,
+    model: Literal["rigid", "sphere", "particle"] = "rigid",
+    friction: bool = False,
+    dtype: type[Float] | np.dtype[Any] = ...,
+) -> tuple[Bodies, Contacts]: ...
+def read_scene(bodies_csv: str, contacts_csv: str, dtype: type[Float] | np.dtype[Any] = ...) -> tuple[Bodies, Contacts]: ...
+def write_scene(bodies_csv: str, contacts_csv: str, bodies: Bodies, contacts: Contacts) -> None: ...
+def from_physical(
+    m: npt.ArrayLike,
+    inertia: npt.ArrayLike,
+    q: npt.ArrayLike,
+    p: npt.ArrayLike,
+    v: npt.ArrayLike | None = None,
+    w: npt.ArrayLike | None = None,
+    *,
+    dtype: type[Float] | np.dtype[Any] = ...,
+) -> Bodies: ...
+def report(
+    *,
+    n: int = 4000000,
+    debris_n: int | None = None,
+    threads: Sequence[int] = (1, 2),
+    sample: int = 100000,
+    runs: int = 5,
+    seed: int = 1,
+    quick: bool = False,
+) -> list[dict[str, Any]]: ...
+def isa_supported(isa: IsaName) -> bool: ...
+def best_isa() -> str: ...
+def simd_width(isa: IsaName = "auto", dtype: type[Float] | np.dtype[Any] = ...) -> int: ...

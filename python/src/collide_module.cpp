@@ -1,0 +1,842 @@
+// python/src/collide_module.cpp - the `collide._collide` extension: a thin
+// shell over the library for NumPy arrays.
+//
+// Design notes
+// ------------
+// * Zero copy: Bodies and Contacts keep the caller's ndarrays and the solve
+//   runs on SoA views of their buffers (row k of a (3, N) array is component
+//   k). Only arrays that already have the right dtype, shape and C layout are
+//   accepted (TypeError otherwise, naming the array): a silent conversion
+//   would copy, and v and w could then not be updated in place.
+// * Values are checked by the library's validate() (ValueError naming the
+//   array and the first bad element) before anything is written, so bad input
+//   modifies nothing. Whether a scene fits a model is model_misfit()'s.
+// * check=False (Solver.solve) skips validate() and the model-fit check for
+//   frame loops that validated their scene once; validate_indices() still
+//   runs, so no index outside the arrays ever reaches the kernel.
+// * The GIL is released around every long C++ call (solve, reference,
+//   report, generate, file I/O). The ndarrays stay referenced by the Bodies
+//   and Contacts objects (and the call's arguments) meanwhile.
+// * The statistics dict is collide::solve_record (collide/check.hpp), the
+//   record `collide solve --stats` prints, and the error per contact is
+//   collide::impulse_errors_eps, what `--check` summarises.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "collide/check.hpp"
+#include "collide/error_bound.hpp"
+#include "collide/generate.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/reference.hpp"
+#include "collide/report.hpp"
+#include "collide/scene.hpp"
+#include "collide/scene_io.hpp"
+#include "collide/schedule.hpp"
+#include "collide/solve.hpp"
+#include "collide/validate.hpp"
+
+namespace py = pybind11;
+
+namespace collide::python {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+std::string text(const py::handle& h) { return py::str(h).cast<std::string>(); }
+
+enum class Dtype { f32, f64 };
+const char* dtype_name(Dtype d) { return d == Dtype::f32 ? "float32" : "float64"; }
+
+py::dtype numpy_dtype(Dtype d) { return d == Dtype::f32 ? py::dtype::of<float>() : py::dtype::of<double>(); }
+
+Dtype parse_dtype(const py::object& dtype) {
+  const py::dtype d = py::dtype::from_args(dtype);
+  if (d.is(py::dtype::of<float>()) || d.equal(py::dtype::of<float>())) return Dtype::f32;
+  if (d.equal(py::dtype::of<double>())) return Dtype::f64;
+  throw py::type_error("dtype must be numpy.float32 or numpy.float64, got " + text(dtype));
+}
+
+std::string shape_text(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t k = 0; k < a.ndim(); ++k) {
+    if (k > 0) s += ", ";
+    s += std::to_string(a.shape(k));
+  }
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+/// The checks of one array argument: an ndarray, of `dtype`, C-contiguous,
+/// aligned, writeable when the solve writes it, of `rows` rows (0: 1-D).
+/// Returns its length (the last dimension). Throws TypeError naming it.
+py::array checked_array(const std::string& owner, const char* name, const py::handle& obj, const py::dtype& dtype,
+                        const char* dtype_text, int rows, bool writeable) {
+  const std::string what = owner + "." + name;
+  if (!py::isinstance<py::array>(obj)) {
+    throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
+  }
+  py::array a = py::reinterpret_borrow<py::array>(obj);
+  if (!a.dtype().equal(dtype)) {
+    throw py::type_error(what + " has dtype " + text(a.dtype()) + ", expected " + dtype_text);
+  }
+  const bool shape_ok = rows == 0 ? a.ndim() == 1 : (a.ndim() == 2 && a.shape(0) == rows);
+  if (!shape_ok) {
+    throw py::type_error(what + " has shape " + shape_text(a) + ", expected " +
+                         (rows == 0 ? std::string("(N,)") : "(" + std::to_string(rows) + ", N)"));
+  }
+  const int flags = a.flags();
+  if ((flags & py::array::c_style) == 0) {
+    throw py::type_error(what + " must be C-contiguous (numpy.ascontiguousarray makes a contiguous copy)");
+  }
+  if ((flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_) == 0) throw py::type_error(what + " must be aligned");
+  if (writeable && (flags & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) == 0) {
+    throw py::type_error(what + " must be writeable: the solve updates it in place");
+  }
+  return a;
+}
+
+std::size_t length(const py::array& a) { return static_cast<std::size_t>(a.shape(a.ndim() - 1)); }
+
+void require_length(const std::string& owner, const char* name, const py::array& a, std::size_t n, const char* first) {
+  if (length(a) != n) {
+    throw py::value_error(owner + "." + name + " has " + std::to_string(length(a)) + " elements, " + first + " has " +
+                          std::to_string(n));
+  }
+}
+
+template <class T>
+T* data(const py::array& a) {
+  return static_cast<T*>(const_cast<void*>(a.data()));
+}
+template <class T>
+Vec3Array<T> vec3(const py::array& a) {
+  T* p = data<T>(a);
+  const std::size_t n = length(a);
+  return {p, p + n, p + 2 * n};
+}
+
+/// The dtype of a scene, from its first floating-point array `what`.
+Dtype scene_dtype(const std::string& what, const py::handle& obj) {
+  if (!py::isinstance<py::array>(obj)) {
+    throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
+  }
+  const py::dtype d = py::reinterpret_borrow<py::array>(obj).dtype();
+  if (d.equal(py::dtype::of<float>())) return Dtype::f32;
+  if (d.equal(py::dtype::of<double>())) return Dtype::f64;
+  throw py::type_error(what + " has dtype " + text(d) + ", expected float32 or float64");
+}
+
+py::array new_array(Dtype d, std::vector<py::ssize_t> shape) { return py::array(numpy_dtype(d), std::move(shape)); }
+
+// ---------------------------------------------------------------------------
+// Bodies and contacts over the caller's arrays.
+// ---------------------------------------------------------------------------
+
+struct Bodies {
+  py::array inv_mass, inv_inertia, q, p, v, w;
+  Dtype dtype = Dtype::f64;
+  std::size_t count = 0;
+
+  Bodies(const py::object& inv_mass_in, const py::object& inv_inertia_in, const py::object& q_in,
+         const py::object& p_in, const py::object& v_in, const py::object& w_in) {
+    const std::string owner = "bodies";
+    dtype = scene_dtype("bodies.inv_mass", inv_mass_in);
+    const py::dtype dt = numpy_dtype(dtype);
+    const char* dn = dtype_name(dtype);
+    inv_mass = checked_array(owner, "inv_mass", inv_mass_in, dt, dn, 0, false);
+    inv_inertia = checked_array(owner, "inv_inertia", inv_inertia_in, dt, dn, 3, false);
+    q = checked_array(owner, "q", q_in, dt, dn, 4, false);
+    p = checked_array(owner, "p", p_in, dt, dn, 3, false);
+    v = checked_array(owner, "v", v_in, dt, dn, 3, true);
+    w = checked_array(owner, "w", w_in, dt, dn, 3, true);
+    count = length(inv_mass);
+    for (const auto& [name, a] : {std::pair<const char*, const py::array*>{"inv_inertia", &inv_inertia},
+                                  {"q", &q},
+                                  {"p", &p},
+                                  {"v", &v},
+                                  {"w", &w}}) {
+      require_length(owner, name, *a, count, "inv_mass");
+    }
+    if (count > std::numeric_limits<BodyIndex>::max()) throw py::value_error("bodies: more than 2^32 - 1 bodies");
+  }
+
+  template <class T>
+  BodyView<T> view() const {
+    T* iq = data<T>(q);
+    return {count,
+            data<T>(inv_mass),
+            vec3<T>(inv_inertia),
+            {iq, iq + count, iq + 2 * count, iq + 3 * count},
+            vec3<T>(p),
+            vec3<T>(v),
+            vec3<T>(w)};
+  }
+};
+
+struct Contacts {
+  py::array a, b, c, n;
+  std::optional<py::array> e, mu;
+  double uniform_e = 1;
+  Dtype dtype = Dtype::f64;
+  std::size_t count = 0;
+
+  Contacts(const py::object& a_in, const py::object& b_in, const py::object& c_in, const py::object& n_in,
+           const py::object& e_in, double uniform_e_in, const py::object& mu_in) {
+    const std::string owner = "contacts";
+    const py::dtype u32 = py::dtype::of<std::uint32_t>();
+    a = checked_array(owner, "a", a_in, u32, "uint32", 0, false);
+    b = checked_array(owner, "b", b_in, u32, "uint32", 0, false);
+    dtype = scene_dtype("contacts.c", c_in);
+    const py::dtype dt = numpy_dtype(dtype);
+    const char* dn = dtype_name(dtype);
+    c = checked_array(owner, "c", c_in, dt, dn, 3, false);
+    n = checked_array(owner, "n", n_in, dt, dn, 3, false);
+    if (!e_in.is_none()) e = checked_array(owner, "e", e_in, dt, dn, 0, false);
+    if (!mu_in.is_none()) mu = checked_array(owner, "mu", mu_in, dt, dn, 0, false);
+    uniform_e = uniform_e_in;
+    count = length(a);
+    require_length(owner, "b", b, count, "a");
+    require_length(owner, "c", c, count, "a");
+    require_length(owner, "n", n, count, "a");
+    if (e) require_length(owner, "e", *e, count, "a");
+    if (mu) require_length(owner, "mu", *mu, count, "a");
+  }
+
+  template <class T>
+  ContactView<T> view() const {
+    ContactView<T> view;
+    view.count = count;
+    view.a = data<BodyIndex>(a);
+    view.b = data<BodyIndex>(b);
+    const Vec3Array<T> cc = vec3<T>(c), nn = vec3<T>(n);
+    view.c = {cc.x, cc.y, cc.z};
+    view.n = {nn.x, nn.y, nn.z};
+    view.e = e ? data<T>(*e) : nullptr;
+    view.uniform_e = static_cast<T>(uniform_e);
+    view.mu = mu ? data<T>(*mu) : nullptr;
+    return view;
+  }
+  py::object e_object() const { return e ? py::object(*e) : py::none(); }
+  py::object mu_object() const { return mu ? py::object(*mu) : py::none(); }
+};
+
+void require_same_dtype(const Bodies& bodies, const Contacts& contacts) {
+  if (bodies.dtype != contacts.dtype) {
+    throw py::type_error(std::string("bodies are ") + dtype_name(bodies.dtype) + " but contacts are " +
+                         dtype_name(contacts.dtype) + ": one precision per solve");
+  }
+}
+
+/// The impulse output: `out` when given (checked like an input), else a new array.
+py::array impulse_array(const py::object& out, Dtype dtype, std::size_t m) {
+  if (out.is_none()) return new_array(dtype, {3, static_cast<py::ssize_t>(m)});
+  py::array j = checked_array("solve", "out", out, numpy_dtype(dtype), dtype_name(dtype), 3, true);
+  require_length("solve", "out", j, m, "contacts.a");
+  return j;
+}
+
+template <class T>
+void validate_or_throw(const Bodies& bodies, const Contacts& contacts, const ImpulseView<T>& j) {
+  if (const Validation v = validate(bodies.view<T>(), contacts.view<T>(), j); !v) throw py::value_error(v.message);
+}
+
+// ---------------------------------------------------------------------------
+// Options.
+// ---------------------------------------------------------------------------
+
+Path parse_path(const std::string& s) {
+  if (s == "simd") return Path::simd;
+  if (s == "scalar") return Path::scalar;
+  throw py::value_error("path must be 'simd' or 'scalar', got '" + s + "'");
+}
+
+/// "auto" -> nullopt.
+std::optional<Model> parse_model(const std::string& s) {
+  if (s == "auto") return std::nullopt;
+  if (s == "rigid") return Model::rigid;
+  if (s == "sphere") return Model::sphere;
+  if (s == "particle") return Model::particle;
+  throw py::value_error("model must be 'auto', 'rigid', 'sphere' or 'particle', got '" + s + "'");
+}
+
+SolverOptions solver_options(const std::string& path, int threads, const py::object& isa, const std::string& accuracy) {
+  SolverOptions o;
+  o.path = parse_path(path);
+  if (threads < 0 || threads > 4096) throw py::value_error("threads must be from 0 (all) to 4096");
+  o.threads = threads;
+  try {
+    if (!isa.is_none()) o.isa = parse_isa(isa.cast<std::string>());
+    o.accuracy = parse_accuracy(accuracy);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  } catch (const py::cast_error&) {
+    throw py::type_error("isa must be a string or None");
+  }
+  return o;
+}
+
+// ---------------------------------------------------------------------------
+// Schedule and solver.
+// ---------------------------------------------------------------------------
+
+/// A schedule built for one set of contacts and bodies; reusable while the
+/// indices and inverse masses do not change (a frame loop over velocities).
+struct PySchedule {
+  Schedule schedule;
+  std::size_t contacts = 0, bodies = 0;
+  double build_seconds = 0;
+
+  template <class T>
+  void build(const Bodies& b, const Contacts& c) {
+    const ContactView<T> cv = c.view<T>();
+    const BodyView<T> bv = b.view<T>();
+    const auto t0 = Clock::now();
+    {
+      py::gil_scoped_release release;
+      schedule.build(cv, bv);
+    }
+    build_seconds = seconds_since(t0);
+    contacts = c.count;
+    bodies = b.count;
+  }
+};
+
+py::dict to_dict(const StatRecord& record) {
+  py::dict d;
+  for (const auto& [key, value] : record) {
+    std::visit([&](const auto& x) { d[py::str(key)] = py::cast(x); }, value);
+  }
+  return d;
+}
+
+struct PySolver {
+  std::unique_ptr<Solver> solver;
+
+  PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy)
+      : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy))) {}
+
+  template <class T>
+  py::tuple solve_t(const Bodies& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
+                    const py::object& out, bool check) {
+    const std::optional<Model> requested = parse_model(model_name);
+    py::array j = impulse_array(out, bodies.dtype, contacts.count);
+    T* jp = data<T>(j);
+    const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
+    const BodyView<T> bv = bodies.view<T>();
+    const ContactView<T> cv = contacts.view<T>();
+    if (check) {
+      validate_or_throw<T>(bodies, contacts, jv);
+    } else if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bv.count); !v) {
+      // Unchecked values are the caller's word; indices never are (memory safety).
+      throw py::value_error(v.message);
+    }
+    Model model = Model::rigid;
+    if (requested) {
+      model = *requested;
+      const std::string misfit = check ? model_misfit(model, bv, cv) : std::string();
+      if (!misfit.empty()) {
+        throw py::value_error(std::string("model '") + to_string(model) + "' does not fit the scene: " + misfit);
+      }
+    } else {
+      model = choose_model(bv, cv);
+    }
+    PySchedule own;
+    if (schedule == nullptr) {
+      own.build<T>(bodies, contacts);
+      schedule = &own;
+    } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
+      throw py::value_error("schedule was built for " + std::to_string(schedule->contacts) + " contacts and " +
+                            std::to_string(schedule->bodies) + " bodies, not " + std::to_string(contacts.count) +
+                            " and " + std::to_string(bodies.count));
+    }
+    SolveStats stats;
+    double kernel_seconds = 0;
+    {
+      py::gil_scoped_release release;
+      const auto t0 = Clock::now();
+      stats = solver->solve(model, bv, cv, jv, schedule->schedule);
+      kernel_seconds = seconds_since(t0);
+    }
+    const ImpulseView<const T> jc{jv.count, {jv.j.x, jv.j.y, jv.j.z}};
+    return py::make_tuple(j, to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds,
+                                                     schedule == &own ? own.build_seconds : 0.0)));
+  }
+
+  py::tuple solve(const Bodies& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
+                  const py::object& out, bool check) {
+    require_same_dtype(bodies, contacts);
+    return bodies.dtype == Dtype::f32 ? solve_t<float>(bodies, contacts, model, schedule, out, check)
+                                      : solve_t<double>(bodies, contacts, model, schedule, out, check);
+  }
+};
+
+// ---------------------------------------------------------------------------
+// The reference and the error measure.
+// ---------------------------------------------------------------------------
+
+/// reference_solve<long double> on an exact copy of the inputs: the caller's
+/// bodies are not modified.
+struct Reference {
+  ImpulseBuffer<long double> impulses;
+  std::vector<ReferenceContact<long double>> diagnostics;
+  BodyBuffer<long double> after;
+  Dtype dtype = Dtype::f64;
+
+  py::array j_array() const {
+    return ld_rows(impulses.view().j.x, impulses.view().j.y, impulses.view().j.z, impulses.size());
+  }
+  py::array vec_array(bool angular) const {
+    const BodyView<const long double> b = after.view();
+    const Vec3Array<const long double> x = angular ? b.w : b.v;
+    return ld_rows(x.x, x.y, x.z, b.count);
+  }
+  py::array diag_array(long double ReferenceContact<long double>::*field) const {
+    py::array_t<double> out(static_cast<py::ssize_t>(diagnostics.size()));
+    double* o = out.mutable_data();
+    for (std::size_t k = 0; k < diagnostics.size(); ++k) o[k] = static_cast<double>(diagnostics[k].*field);
+    return out;
+  }
+  static py::array ld_rows(const long double* x, const long double* y, const long double* z, std::size_t n) {
+    py::array_t<double> out({py::ssize_t{3}, static_cast<py::ssize_t>(n)});
+    double* o = out.mutable_data();
+    for (std::size_t k = 0; k < n; ++k) {
+      o[k] = static_cast<double>(x[k]);
+      o[n + k] = static_cast<double>(y[k]);
+      o[2 * n + k] = static_cast<double>(z[k]);
+    }
+    return out;
+  }
+};
+
+template <class T>
+std::shared_ptr<Reference> reference_t(const Bodies& bodies, const Contacts& contacts) {
+  const ImpulseView<T> none{contacts.count, {}};
+  auto r = std::make_shared<Reference>();
+  r->dtype = bodies.dtype;
+  // validate() needs impulse storage of the right size: check the inputs with
+  // a scratch buffer.
+  ImpulseBuffer<T> scratch(contacts.count);
+  validate_or_throw<T>(bodies, contacts, scratch.view());
+  const BodyView<T> bv = bodies.view<T>();
+  const ContactView<T> cv = contacts.view<T>();
+  {
+    py::gil_scoped_release release;
+    r->after = convert_bodies<long double>(BodyView<const T>{bv.count,
+                                                             bv.inv_mass,
+                                                             {bv.inv_inertia.x, bv.inv_inertia.y, bv.inv_inertia.z},
+                                                             {bv.q.w, bv.q.x, bv.q.y, bv.q.z},
+                                                             {bv.p.x, bv.p.y, bv.p.z},
+                                                             {bv.v.x, bv.v.y, bv.v.z},
+                                                             {bv.w.x, bv.w.y, bv.w.z}});
+    const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
+    r->impulses.resize(contacts.count);
+    r->diagnostics.resize(contacts.count);
+    reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data());
+  }
+  (void)none;
+  return r;
+}
+
+std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts) {
+  require_same_dtype(bodies, contacts);
+  return bodies.dtype == Dtype::f32 ? reference_t<float>(bodies, contacts) : reference_t<double>(bodies, contacts);
+}
+
+template <class T>
+py::array impulse_error_t(const py::array& j, const Reference& ref) {
+  const std::size_t m = length(j);
+  const T* p = data<T>(j);
+  const ImpulseView<const T> jv{m, {p, p + m, p + 2 * m}};
+  const ImpulseView<const long double> rv = ref.impulses.view();
+  const std::vector<double> errors = impulse_errors_eps<T>(jv, rv, ref.diagnostics);
+  py::array_t<double> out(static_cast<py::ssize_t>(m));
+  std::copy(errors.begin(), errors.end(), out.mutable_data());
+  return out;
+}
+
+py::array impulse_error_py(const py::object& j_in, const Reference& ref) {
+  const Dtype dtype = scene_dtype("impulse_error.J", j_in);
+  const py::array j = checked_array("impulse_error", "J", j_in, numpy_dtype(dtype), "float32 or float64", 3, false);
+  require_length("impulse_error", "J", j, ref.impulses.size(), "the reference");
+  return dtype == Dtype::f32 ? impulse_error_t<float>(j, ref) : impulse_error_t<double>(j, ref);
+}
+
+// ---------------------------------------------------------------------------
+// Scenes: generated, read, written; bodies from physical units.
+// ---------------------------------------------------------------------------
+
+template <class T>
+py::array copy_rows(Dtype d, std::initializer_list<const T*> rows, std::size_t n) {
+  const bool one = rows.size() == 1;
+  py::array a = one ? new_array(d, {static_cast<py::ssize_t>(n)})
+                    : new_array(d, {static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(n)});
+  T* o = data<T>(a);
+  for (const T* r : rows) {
+    std::copy(r, r + n, o);
+    o += n;
+  }
+  return a;
+}
+
+template <class T>
+py::tuple to_python(const BodyView<const T>& b, const ContactView<T>& c, Dtype d) {
+  const std::size_t n = b.count, m = c.count;
+  py::object bodies = py::cast(
+      Bodies(copy_rows<T>(d, {b.inv_mass}, n), copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
+             copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
+             copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
+  py::array_t<std::uint32_t> a(static_cast<py::ssize_t>(m)), bb(static_cast<py::ssize_t>(m));
+  std::copy(c.a, c.a + m, a.mutable_data());
+  std::copy(c.b, c.b + m, bb.mutable_data());
+  py::object e = c.e ? py::object(copy_rows<T>(d, {c.e}, m)) : py::none();
+  py::object mu = c.mu ? py::object(copy_rows<T>(d, {c.mu}, m)) : py::none();
+  py::object contacts =
+      py::cast(Contacts(a, bb, copy_rows<T>(d, {c.c.x, c.c.y, c.c.z}, m), copy_rows<T>(d, {c.n.x, c.n.y, c.n.z}, m), e,
+                        static_cast<double>(c.uniform_e), mu));
+  return py::make_tuple(bodies, contacts);
+}
+
+template <class T>
+py::tuple scene_to_python(const Scene<T>& s, Dtype d) {
+  return to_python<T>(s.bodies.view(), s.contacts.view(), d);
+}
+
+py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
+                      bool friction, const py::object& dtype_in) {
+  const Dtype d = parse_dtype(dtype_in);
+  if (kind != "pairs" && kind != "debris")
+    throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
+  GenerateOptions o;
+  o.seed = seed;
+  o.friction = friction;
+  const std::optional<Model> m = parse_model(model);
+  if (!m) throw py::value_error("generate needs a model: 'rigid', 'sphere' or 'particle'");
+  o.model = *m;
+  auto run = [&](auto tag) {
+    using T = decltype(tag);
+    Scene<T> s;
+    {
+      py::gil_scoped_release release;
+      s = kind == "pairs" ? generate_pairs<T>(n, o) : generate_debris<T>(n, o);
+    }
+    return scene_to_python<T>(s, d);
+  };
+  return d == Dtype::f32 ? run(float{}) : run(double{});
+}
+
+/// Scene-file errors become ValueError with the library's message (file,
+/// line, row, column); I/O failures OSError.
+template <class F>
+auto translate_io(F&& f) {
+  try {
+    return f();
+  } catch (const SceneError& e) {
+    throw py::value_error(e.what());
+  }
+}
+
+py::tuple read_scene_py(const std::string& bodies_csv, const std::string& contacts_csv, const py::object& dtype_in) {
+  const Dtype d = parse_dtype(dtype_in);
+  auto run = [&](auto tag) {
+    using T = decltype(tag);
+    Scene<T> s;
+    translate_io([&] {
+      py::gil_scoped_release release;
+      const BodyTable<T> table = read_bodies<T>(bodies_csv);
+      s.contacts = read_contacts<T>(contacts_csv, table.size());
+      s.bodies = to_body_buffer(table);
+      return 0;
+    });
+    return scene_to_python<T>(s, d);
+  };
+  return d == Dtype::f32 ? run(float{}) : run(double{});
+}
+
+template <class T>
+void write_scene_t(const std::string& bodies_csv, const std::string& contacts_csv, const Bodies& bodies,
+                   const Contacts& contacts) {
+  const BodyView<T> bv = bodies.view<T>();
+  const ContactView<T> cv = contacts.view<T>();
+  ImpulseBuffer<T> scratch(contacts.count);
+  validate_or_throw<T>(bodies, contacts, scratch.view());
+  py::gil_scoped_release release;
+  // Physical units from the inverses (BodyBuffer::record: 1/0 gives inf).
+  const BodyBuffer<T> copy = convert_bodies<T>(bv);
+  std::string btext(bodies_header());
+  for (std::size_t i = 0; i < copy.size(); ++i) append_body_row(btext, copy.record(i));
+  ContactBuffer<T> cb;
+  cb.assign_exact(cv);
+  std::string ctext(contacts_header());
+  for (std::size_t k = 0; k < cb.size(); ++k) append_contact_row(ctext, cb.record(k));
+  OutputFile ob(bodies_csv), oc(contacts_csv);
+  ob.write(btext);
+  oc.write(ctext);
+  ob.commit();
+  oc.commit();
+}
+
+void write_scene_py(const std::string& bodies_csv, const std::string& contacts_csv, const Bodies& bodies,
+                    const Contacts& contacts) {
+  require_same_dtype(bodies, contacts);
+  if (bodies.dtype == Dtype::f32) {
+    write_scene_t<float>(bodies_csv, contacts_csv, bodies, contacts);
+  } else {
+    write_scene_t<double>(bodies_csv, contacts_csv, bodies, contacts);
+  }
+}
+
+/// Bodies from physical units: mass (inf = immovable), principal moments
+/// (inf = no rotation about that axis), any non-zero quaternion (normalised),
+/// as BodyBuffer::set stores them.
+py::object from_physical_py(const py::object& m_in, const py::object& inertia_in, const py::object& q_in,
+                            const py::object& p_in, const py::object& v_in, const py::object& w_in,
+                            const py::object& dtype_in) {
+  const Dtype d = parse_dtype(dtype_in);
+  const py::dtype dt = numpy_dtype(d);
+  const char* dn = dtype_name(d);
+  const std::string owner = "from_physical";
+  const py::array m = checked_array(owner, "m", m_in, dt, dn, 0, false);
+  const py::array I = checked_array(owner, "inertia", inertia_in, dt, dn, 3, false);
+  const py::array q = checked_array(owner, "q", q_in, dt, dn, 4, false);
+  const py::array p = checked_array(owner, "p", p_in, dt, dn, 3, false);
+  const py::array v = checked_array(owner, "v", v_in, dt, dn, 3, false);
+  const py::array w = checked_array(owner, "w", w_in, dt, dn, 3, false);
+  const std::size_t n = length(m);
+  for (const auto& [name, a] :
+       {std::pair<const char*, const py::array*>{"inertia", &I}, {"q", &q}, {"p", &p}, {"v", &v}, {"w", &w}}) {
+    require_length(owner, name, *a, n, "m");
+  }
+  auto run = [&](auto tag) {
+    using T = decltype(tag);
+    BodyBuffer<T> buffer(n);
+    const T *pm = data<T>(m), *pI = data<T>(I), *pq = data<T>(q), *pp = data<T>(p), *pv = data<T>(v), *pw = data<T>(w);
+    for (std::size_t i = 0; i < n; ++i) {
+      BodyRecord<T> r;
+      r.m = pm[i];
+      if (!(r.m > T(0))) {
+        throw py::value_error("from_physical: m[" + std::to_string(i) + "] = " + std::to_string(r.m) +
+                              ": must be > 0 (inf = immovable)");
+      }
+      for (int k = 0; k < 3; ++k) {
+        r.I[k] = pI[k * n + i];
+        if (!(r.I[k] > T(0))) {
+          throw py::value_error("from_physical: inertia[" + std::to_string(k) + ", " + std::to_string(i) +
+                                "] = " + std::to_string(r.I[k]) + ": must be > 0 (inf = locked axis)");
+        }
+        r.p[k] = pp[k * n + i];
+        r.v[k] = pv[k * n + i];
+        r.w[k] = pw[k * n + i];
+      }
+      T qn = 0;
+      for (int k = 0; k < 4; ++k) {
+        r.q[k] = pq[k * n + i];
+        qn += r.q[k] * r.q[k];
+      }
+      if (!(qn > T(0)) || !std::isfinite(qn)) {
+        throw py::value_error("from_physical: q[:, " + std::to_string(i) + "]: must be finite and non-zero");
+      }
+      buffer.set(i, r);
+    }
+    const BodyView<const T> b = std::as_const(buffer).view();
+    return py::cast(Bodies(copy_rows<T>(d, {b.inv_mass}, n),
+                           copy_rows<T>(d, {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z}, n),
+                           copy_rows<T>(d, {b.q.w, b.q.x, b.q.y, b.q.z}, n), copy_rows<T>(d, {b.p.x, b.p.y, b.p.z}, n),
+                           copy_rows<T>(d, {b.v.x, b.v.y, b.v.z}, n), copy_rows<T>(d, {b.w.x, b.w.y, b.w.z}, n)));
+  };
+  return d == Dtype::f32 ? run(float{}) : run(double{});
+}
+
+// ---------------------------------------------------------------------------
+// The report.
+// ---------------------------------------------------------------------------
+
+py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::vector<int> threads, std::size_t sample,
+                   int runs, std::uint64_t seed, bool quick) {
+  ReportOptions o;
+  o.n = n;
+  o.debris_n = debris_n ? *debris_n : std::min<std::size_t>(n, o.debris_n);
+  o.threads = std::move(threads);
+  o.sample = sample;
+  o.runs = runs;
+  o.seed = seed;
+  o.quick = quick;
+  Report r;
+  try {
+    py::gil_scoped_release release;
+    r = measure_report(o);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  py::list rows;
+  for (const ReportRow& x : r.rows) {
+    py::dict d;
+    d["scene"] = x.scene;
+    d["variant"] = x.variant;
+    d["model"] = x.model;
+    d["precision"] = x.precision;
+    d["simd"] = x.simd;
+    d["friction"] = x.friction;
+    d["threads"] = x.threads;
+    d["n"] = x.n;
+    d["lanes"] = x.lanes;
+    d["isa"] = x.isa;
+    d["layout"] = x.layout;
+    d["runs"] = x.runs;
+    d["seconds"] = x.seconds;
+    d["collisions_per_second"] = x.collisions_per_second;
+    d["bytes_per_collision"] = x.bytes_per_collision;
+    d["bandwidth_fraction"] = x.bandwidth_fraction;
+    d["error_sample"] = x.error_sample;
+    d["eps"] = x.eps;
+    d["max_err_eps"] = x.max_err_eps;
+    d["p99_err_eps"] = x.p99_err_eps;
+    d["max_rel_err"] = x.max_rel_err;
+    d["momentum_drift"] = x.momentum_drift;
+    d["angular_momentum_drift"] = x.angular_momentum_drift;
+    d["energy_drift"] = x.energy_drift;
+    d["note"] = x.note;
+    rows.append(d);
+  }
+  return rows;
+}
+
+}  // namespace
+}  // namespace collide::python
+
+PYBIND11_MODULE(_collide, m) {
+  using namespace collide::python;
+  namespace c = collide;
+  m.doc() = "collide: batched rigid-body collision impulses (the C++ extension; use the collide package)";
+
+  py::class_<Bodies>(m, "Bodies")
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
+                    const py::object&>(),
+           py::arg("inv_mass"), py::arg("inv_inertia"), py::arg("q"), py::arg("p"), py::arg("v"), py::arg("w"))
+      .def_readonly("inv_mass", &Bodies::inv_mass)
+      .def_readonly("inv_inertia", &Bodies::inv_inertia)
+      .def_readonly("q", &Bodies::q)
+      .def_readonly("p", &Bodies::p)
+      .def_readonly("v", &Bodies::v)
+      .def_readonly("w", &Bodies::w)
+      .def_property_readonly("dtype", [](const Bodies& b) { return numpy_dtype(b.dtype); })
+      .def("__len__", [](const Bodies& b) { return b.count; });
+
+  py::class_<Contacts>(m, "Contacts")
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
+                    double, const py::object&>(),
+           py::arg("a"), py::arg("b"), py::arg("c"), py::arg("n"), py::arg("e") = py::none(),
+           py::arg("uniform_e") = 1.0, py::arg("mu") = py::none())
+      .def_readonly("a", &Contacts::a)
+      .def_readonly("b", &Contacts::b)
+      .def_readonly("c", &Contacts::c)
+      .def_readonly("n", &Contacts::n)
+      .def_property_readonly("e", &Contacts::e_object)
+      .def_property_readonly("mu", &Contacts::mu_object)
+      .def_readonly("uniform_e", &Contacts::uniform_e)
+      .def_property_readonly("dtype", [](const Contacts& c) { return numpy_dtype(c.dtype); })
+      .def("__len__", [](const Contacts& c) { return c.count; });
+
+  py::class_<PySchedule>(m, "Schedule")
+      .def(py::init([](const Bodies& bodies, const Contacts& contacts) {
+             require_same_dtype(bodies, contacts);
+             auto s = std::make_unique<PySchedule>();
+             // The schedule reads indices: they must be in range first.
+             if (bodies.dtype == Dtype::f32) {
+               c::ImpulseBuffer<float> scratch(contacts.count);
+               validate_or_throw<float>(bodies, contacts, scratch.view());
+               s->build<float>(bodies, contacts);
+             } else {
+               c::ImpulseBuffer<double> scratch(contacts.count);
+               validate_or_throw<double>(bodies, contacts, scratch.view());
+               s->build<double>(bodies, contacts);
+             }
+             return s;
+           }),
+           py::arg("bodies"), py::arg("contacts"))
+      .def_property_readonly("batches", [](const PySchedule& s) { return s.schedule.batch_count(); })
+      .def_property_readonly("largest_batch", [](const PySchedule& s) { return s.schedule.largest_batch(); })
+      .def_readonly("build_seconds", &PySchedule::build_seconds);
+
+  py::class_<PySolver>(m, "Solver")
+      .def(py::init<const std::string&, int, const py::object&, const std::string&>(), py::kw_only(),
+           py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(), py::arg("accuracy") = "fast")
+      .def_property_readonly("path", [](const PySolver& s) { return c::to_string(s.solver->options().path); })
+      .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
+      .def_property_readonly("isa", [](const PySolver& s) { return c::to_string(s.solver->isa()); })
+      .def_property_readonly("accuracy", [](const PySolver& s) { return c::to_string(s.solver->options().accuracy); })
+      .def("solve", &PySolver::solve, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("model") = "auto",
+           py::arg("schedule") = nullptr, py::arg("out") = py::none(), py::arg("check") = true);
+
+  py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
+      .def_property_readonly("J", &Reference::j_array)
+      .def_property_readonly("v", [](const Reference& r) { return r.vec_array(false); })
+      .def_property_readonly("w", [](const Reference& r) { return r.vec_array(true); })
+      .def_property_readonly(
+          "impulse_scale",
+          [](const Reference& r) { return r.diag_array(&c::ReferenceContact<long double>::impulse_scale); })
+      .def_property_readonly("dtype", [](const Reference& r) { return numpy_dtype(r.dtype); })
+      .def("__len__", [](const Reference& r) { return r.impulses.size(); });
+
+  m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"));
+  m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
+  m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
+        py::arg("model") = "rigid", py::arg("friction") = false, py::arg("dtype") = py::none());
+  m.def("read_scene", &read_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::kw_only(), py::arg("dtype"));
+  m.def("write_scene", &write_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::arg("bodies"),
+        py::arg("contacts"));
+  m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
+        py::arg("w"), py::arg("dtype"));
+  m.def("report", &report_py, py::kw_only(), py::arg("n") = 4000000, py::arg("debris_n") = py::none(),
+        py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000, py::arg("runs") = 5,
+        py::arg("seed") = 1, py::arg("quick") = false);
+  m.attr("error_bound_eps") = c::kImpulseErrorBoundEps;
+  m.def(
+      "simd_width",
+      [](const std::string& isa, const py::object& dtype) {
+        const Dtype d = parse_dtype(dtype);
+        c::Isa i;
+        try {
+          i = c::resolve_isa(c::parse_isa(isa));
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+        return d == Dtype::f32 ? c::simd_width<float>(i) : c::simd_width<double>(i);
+      },
+      py::arg("isa") = "auto", py::arg("dtype"));
+  m.def(
+      "isa_supported",
+      [](const std::string& isa) {
+        try {
+          return c::isa_supported(c::parse_isa(isa));
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("isa"));
+  m.def("best_isa", [] { return std::string(c::to_string(c::best_isa())); });
+
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const c::SceneError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+}

@@ -1,0 +1,163 @@
+"""Every bad input of issue 14: TypeError for dtype, shape and layout,
+ValueError for lengths, indices, a == b, NaN/inf, negative inverse mass,
+non-unit quaternion or normal; the message names the array and the first
+bad element, and nothing is modified."""
+
+import numpy as np
+import pytest
+
+import collide
+
+FIELDS = ("inv_mass", "inv_inertia", "q", "p", "v", "w")
+
+
+def scene(dtype=np.float64, n=40):
+    bodies, contacts = collide.generate("pairs", n, friction=True, dtype=dtype)
+    arrays = {f: np.array(getattr(bodies, f)) for f in FIELDS}
+    carrays = {f: np.array(getattr(contacts, f)) for f in ("a", "b", "c", "n", "mu")}
+    carrays["e"] = np.array(contacts.e)
+    return arrays, carrays
+
+
+def make(arrays, carrays):
+    b = collide.Bodies(*(arrays[f] for f in FIELDS))
+    c = collide.Contacts(carrays["a"], carrays["b"], carrays["c"], carrays["n"], e=carrays["e"], mu=carrays["mu"])
+    return b, c
+
+
+@pytest.mark.parametrize("field", FIELDS)
+def test_wrong_dtype(field):
+    arrays, _ = scene()
+    arrays[field] = arrays[field].astype(np.float32)
+    # inv_mass sets the scene's dtype: then the next array is the odd one.
+    name = "inv_inertia" if field == "inv_mass" else field
+    with pytest.raises(TypeError, match=rf"bodies\.{name} has dtype float(32|64), expected float"):
+        collide.Bodies(*(arrays[f] for f in FIELDS))
+
+
+def test_wrong_shape_and_layout():
+    arrays, carrays = scene()
+    bad = dict(arrays, v=arrays["v"][:2].copy())
+    with pytest.raises(TypeError, match=r"bodies\.v has shape \(2, 80\)"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+    bad = dict(arrays, q=np.asfortranarray(arrays["q"]))
+    with pytest.raises(TypeError, match=r"bodies\.q must be C-contiguous"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+    bad = dict(arrays, p=arrays["p"].tolist())
+    with pytest.raises(TypeError, match=r"bodies\.p must be a numpy\.ndarray"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+    ro = arrays["w"].copy()
+    ro.setflags(write=False)
+    with pytest.raises(TypeError, match=r"bodies\.w must be writeable"):
+        collide.Bodies(*(dict(arrays, w=ro)[f] for f in FIELDS))
+    with pytest.raises(TypeError, match=r"contacts\.a has dtype int64"):
+        collide.Contacts(carrays["a"].astype(np.int64), carrays["b"], carrays["c"], carrays["n"])
+    with pytest.raises(TypeError, match=r"contacts\.n has shape"):
+        collide.Contacts(carrays["a"], carrays["b"], carrays["c"], carrays["n"].T.copy())
+    with pytest.raises(TypeError, match=r"contacts\.c must be C-contiguous"):
+        collide.Contacts(carrays["a"], carrays["b"], np.asfortranarray(carrays["c"]), carrays["n"])
+
+
+def test_lengths():
+    arrays, carrays = scene()
+    bad = dict(arrays, w=np.zeros((3, 79)))
+    with pytest.raises(ValueError, match=r"bodies\.w has 79 elements, inv_mass has 80"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+    with pytest.raises(ValueError, match=r"contacts\.mu has 3 elements"):
+        collide.Contacts(carrays["a"], carrays["b"], carrays["c"], carrays["n"], mu=np.zeros(3))
+    b, c = make(arrays, carrays)
+    with pytest.raises(ValueError, match=r"solve\.out has"):
+        collide.solve(b, c, out=np.zeros((3, 5)))
+
+
+def test_mixed_dtypes():
+    arrays, _ = scene(np.float64)
+    _, carrays = scene(np.float32)
+    b, c = make(arrays, carrays)
+    with pytest.raises(TypeError, match="bodies are float64 but contacts are float32"):
+        collide.solve(b, c)
+
+
+def corrupt(kind):
+    """A scene with one bad value, and the message naming it."""
+    arrays, carrays = scene()
+    if kind == "index":
+        carrays["b"][7] = 80
+        return arrays, carrays, r"contacts\.b\[7\] = 80: out of range"
+    if kind == "self":
+        carrays["b"][5] = carrays["a"][5]
+        return arrays, carrays, r"contacts\.b\[5\].*itself"
+    if kind == "nan_v":
+        arrays["v"][1, 9] = np.nan
+        return arrays, carrays, r"bodies\.v\.y\[9\] = nan: must be finite"
+    if kind == "inf_c":
+        carrays["c"][2, 3] = np.inf
+        return arrays, carrays, r"contacts\.c\.z\[3\] = inf: must be finite"
+    if kind == "negative_mass":
+        arrays["inv_mass"][4] = -1.0
+        return arrays, carrays, r"bodies\.inv_mass\[4\] = -1"
+    if kind == "quaternion":
+        arrays["q"][:, 6] = [2.0, 0.0, 0.0, 0.0]
+        return arrays, carrays, r"bodies\.\|q\|\[6\] = 2"
+    if kind == "normal":
+        carrays["n"][:, 11] *= 1.5
+        return arrays, carrays, r"contacts\.\|n\|\[11\] = 1\.5"
+    if kind == "restitution":
+        carrays["e"][2] = 1.5
+        return arrays, carrays, r"contacts\.e\[2\] = 1\.5"
+    raise AssertionError(kind)
+
+
+@pytest.mark.parametrize("kind", ["index", "self", "nan_v", "inf_c", "negative_mass", "quaternion", "normal",
+                                  "restitution"])
+def test_bad_values_name_the_element_and_modify_nothing(kind):
+    arrays, carrays, message = corrupt(kind)
+    b, c = make(arrays, carrays)
+    before = {f: arrays[f].copy() for f in FIELDS}
+    out = np.full((3, len(c)), 7.0)
+    with pytest.raises(ValueError, match=message):
+        collide.solve(b, c, out=out)
+    for f in FIELDS:
+        assert np.array_equal(arrays[f], before[f], equal_nan=True), f
+    assert np.all(out == 7.0)
+    with pytest.raises(ValueError, match=message):
+        collide.reference_solve(b, c)
+    with pytest.raises(ValueError, match=message):
+        collide.Schedule(b, c)
+
+
+def test_bad_file(tmp_path):
+    (tmp_path / "b.csv").write_text("m,Ix\n1,2\n")
+    (tmp_path / "c.csv").write_text("a,b\n")
+    with pytest.raises(ValueError, match="b.csv"):
+        collide.read_scene(tmp_path / "b.csv", tmp_path / "c.csv")
+
+
+def test_bad_options():
+    with pytest.raises(ValueError, match="threads"):
+        collide.Solver(threads=-1)
+    with pytest.raises(TypeError, match="dtype"):
+        collide.generate("pairs", 10, dtype=np.int32)
+    with pytest.raises(ValueError, match="kind"):
+        collide.generate("cubes", 10)
+
+
+@pytest.mark.parametrize("kind", ["index", "self"])
+def test_unchecked_solve_still_checks_indices(kind):
+    arrays, carrays, message = corrupt(kind)
+    b, c = make(arrays, carrays)
+    before = {f: arrays[f].copy() for f in FIELDS}
+    with pytest.raises(ValueError, match=message):
+        collide.solve(b, c, model="rigid", check=False)
+    for f in FIELDS:
+        assert np.array_equal(arrays[f], before[f]), f
+
+
+def test_unchecked_solve_is_the_same_solve():
+    bodies, contacts = collide.generate("debris", 3000, friction=True, dtype=np.float32)
+    v0, w0 = bodies.v.copy(), bodies.w.copy()
+    J1, _ = collide.solve(bodies, contacts)
+    np.copyto(bodies.v, v0)
+    np.copyto(bodies.w, w0)
+    J2, _ = collide.solve(bodies, contacts, model="rigid", check=False)
+    assert np.array_equal(J1, J2)

@@ -1,0 +1,185 @@
+"""collide.solve against `collide solve`, in place and without copies."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+import collide
+from conftest import run
+
+
+def read_impulses(path, dtype):
+    # The CLI writes the shortest decimal that reads back to the same value.
+    rows = np.loadtxt(path, delimiter=",", skiprows=1, dtype=np.float64, ndmin=2)
+    return np.ascontiguousarray(rows.T.astype(dtype))
+
+
+@pytest.mark.parametrize("dtype,precision", [(np.float32, "float"), (np.float64, "double")])
+@pytest.mark.parametrize("scene", [["--pairs", "3000"], ["--debris", "3000", "--friction"]])
+def test_bitwise_equal_to_cli(cli, workdir, dtype, precision, scene):
+    run([cli, "gen", *scene, "--out", workdir, "--seed", "7"])
+    b_csv, c_csv = os.path.join(workdir, "bodies.csv"), os.path.join(workdir, "contacts.csv")
+    ob, oj = os.path.join(workdir, "out_bodies.csv"), os.path.join(workdir, "out_j.csv")
+    r = run([cli, "solve", "--bodies", b_csv, "--contacts", c_csv, "--out-bodies", ob, "--out-impulses", oj,
+             "--precision", precision, "--stats"])
+    cli_stats = json.loads(r.stderr.strip().splitlines()[-1])
+
+    bodies, contacts = collide.read_scene(b_csv, c_csv, dtype=dtype)
+    J, stats = collide.solve(bodies, contacts)
+    assert J.dtype == dtype and J.shape == (3, len(contacts))
+    np.testing.assert_array_equal(J.view(np.uint32 if dtype == np.float32 else np.uint64),
+                                  read_impulses(oj, dtype).view(np.uint32 if dtype == np.float32 else np.uint64))
+    after, _ = collide.read_scene(ob, c_csv, dtype=dtype)
+    assert np.array_equal(bodies.v, after.v) and np.array_equal(bodies.w, after.w)
+    # The stats dict has every key of --stats that is not about files.
+    for key in set(cli_stats) - {"read_seconds", "write_seconds", "io_seconds", "io_fraction"}:
+        assert key in stats, key
+    for key in ("collisions", "impacts", "bodies", "precision", "model", "path", "lanes", "batches", "largest_batch",
+                "isa", "accuracy"):
+        assert stats[key] == cli_stats[key], key
+
+
+def test_zero_copy_and_in_place():
+    bodies, contacts = collide.generate("pairs", 1000, dtype=np.float64)
+    v, w = bodies.v, bodies.w
+    addr_v, addr_w = v.ctypes.data, w.ctypes.data
+    v0, w0 = v.copy(), w.copy()
+    J, _ = collide.solve(bodies, contacts)
+    assert bodies.v is v and bodies.w is w
+    assert v.ctypes.data == addr_v and w.ctypes.data == addr_w
+    assert not np.array_equal(v, v0) and not np.array_equal(w, w0)
+
+    # Bodies built over the caller's own arrays keep them, not copies.
+    arrays = [np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q, bodies.p, v0, w0)]
+    mine = collide.Bodies(*arrays)
+    for name, a in zip(("inv_mass", "inv_inertia", "q", "p", "v", "w"), arrays):
+        assert getattr(mine, name).ctypes.data == a.ctypes.data, name
+    collide.solve(mine, contacts)
+    assert np.array_equal(arrays[4], bodies.v)  # the caller's v was updated in place, same result
+
+    # out=: J written into the caller's buffer.
+    out = np.empty((3, len(contacts)), dtype=np.float64)
+    arrays2 = [np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q, bodies.p, v0, w0)]
+    J2, _ = collide.solve(collide.Bodies(*arrays2), contacts, out=out)
+    assert J2.ctypes.data == out.ctypes.data and np.array_equal(out, J)
+
+
+def test_paths_models_threads_and_isas_agree():
+    bodies, contacts = collide.generate("debris", 5000, friction=True, dtype=np.float32)
+    v0, w0 = bodies.v.copy(), bodies.w.copy()
+    results = []
+    isas = [isa for isa in ("sse2", "avx2", "avx512") if collide.isa_supported(isa)]
+    for kwargs in ({"path": "scalar"}, {"path": "simd", "threads": 1}, {"threads": 2},
+                   *({"isa": isa} for isa in isas)):
+        bodies.v[...] = v0
+        bodies.w[...] = w0
+        J, stats = collide.solve(bodies, contacts, **kwargs)
+        results.append((J, bodies.v.copy(), bodies.w.copy()))
+    for J, v, w in results[1:]:
+        assert np.array_equal(J, results[0][0]) and np.array_equal(v, results[0][1]) and np.array_equal(w, results[0][2])
+
+
+def test_solver_and_schedule_reuse():
+    bodies, contacts = collide.generate("debris", 2000, dtype=np.float64)
+    v0, w0 = bodies.v.copy(), bodies.w.copy()
+    J1, _ = collide.solve(bodies, contacts)
+    bodies.v[...] = v0
+    bodies.w[...] = w0
+    solver = collide.Solver(threads=1)
+    schedule = collide.Schedule(bodies, contacts)
+    assert schedule.batches >= 1
+    J2, stats = solver.solve(bodies, contacts, schedule=schedule)
+    assert np.array_equal(J1, J2)
+    other, other_contacts = collide.generate("pairs", 10, dtype=np.float64)
+    with pytest.raises(ValueError, match="schedule was built for"):
+        solver.solve(other, other_contacts, schedule=schedule)
+
+
+def test_isa_and_accuracy_pass_through():
+    bodies, contacts = collide.generate("pairs", 100, dtype=np.float32)
+    solver = collide.Solver(isa="sse2", accuracy="fast")
+    assert solver.isa == "sse2" and solver.accuracy == "fast"  # the options reach the library's Solver
+    _, stats = solver.solve(bodies, contacts)
+    assert stats["accuracy"] == "fast"
+    assert stats["isa"] == "sse2"  # what ran (SolveStats::isa)
+    _, stats = collide.solve(bodies, contacts)
+    assert stats["isa"] == collide.Solver().isa and collide.isa_supported(stats["isa"])
+    with pytest.raises(ValueError, match="accuracy"):
+        collide.solve(bodies, contacts, accuracy="sloppy")
+    with pytest.raises(ValueError, match="instruction set"):
+        collide.solve(bodies, contacts, isa="mmx")
+    with pytest.raises(ValueError, match="path"):
+        collide.solve(bodies, contacts, path="gpu")
+    with pytest.raises(ValueError, match="model"):
+        collide.solve(bodies, contacts, model="cube")
+
+
+def test_models_fit_or_refuse():
+    bodies, contacts = collide.generate("pairs", 100, model="particle", dtype=np.float64)
+    _, stats = collide.solve(bodies, contacts)
+    assert stats["model"] == "particle"
+    rigid, rc = collide.generate("pairs", 100, model="rigid", dtype=np.float64)
+    with pytest.raises(ValueError, match="does not fit"):
+        collide.solve(rigid, rc, model="particle")
+
+
+def test_reference_and_impulse_error_match_check(cli, workdir):
+    run([cli, "gen", "--debris", "2000", "--friction", "--out", workdir])
+    b_csv, c_csv = os.path.join(workdir, "bodies.csv"), os.path.join(workdir, "contacts.csv")
+    ob, oj = os.path.join(workdir, "ob.csv"), os.path.join(workdir, "oj.csv")
+    r = run([cli, "solve", "--bodies", b_csv, "--contacts", c_csv, "--out-bodies", ob, "--out-impulses", oj,
+             "--precision", "float", "--stats", "--check"])
+    cli_stats = json.loads(r.stderr.strip().splitlines()[-1])
+    bodies, contacts = collide.read_scene(b_csv, c_csv, dtype=np.float32)
+    v0 = bodies.v.copy()
+    ref = collide.reference_solve(bodies, contacts)
+    assert np.array_equal(bodies.v, v0)  # the reference works on a copy
+    J, _ = collide.solve(bodies, contacts)
+    err = collide.impulse_error(J, ref)
+    assert err.shape == (len(contacts),) and err.dtype == np.float64
+    assert float(np.max(err)) == pytest.approx(cli_stats["max_impulse_error_eps"], rel=1e-8)
+    assert int(np.argmax(err)) == cli_stats["worst_contact"]
+    assert np.max(err) <= collide.error_bound_eps
+    # The measure is not blind: a perturbed impulse shows its error.
+    bad = J.copy()
+    k = int(np.argmax(ref.impulse_scale))
+    bad[0, k] += np.float32(1e3) * np.finfo(np.float32).eps * np.float32(ref.impulse_scale[k])
+    assert collide.impulse_error(bad, ref)[k] > 500
+
+
+def test_scene_round_trip(workdir):
+    bodies, contacts = collide.generate("debris", 500, friction=True, dtype=np.float64)
+    b_csv, c_csv = os.path.join(workdir, "b.csv"), os.path.join(workdir, "c.csv")
+    collide.write_scene(b_csv, c_csv, bodies, contacts)
+    b2, c2 = collide.read_scene(b_csv, c_csv, dtype=np.float64)
+    for name in ("v", "w", "p"):
+        assert np.array_equal(getattr(b2, name), getattr(bodies, name)), name
+    np.testing.assert_allclose(b2.inv_mass, bodies.inv_mass, rtol=1e-15)
+    assert np.array_equal(c2.a, contacts.a) and np.array_equal(c2.b, contacts.b)
+    np.testing.assert_allclose(c2.n, contacts.n, rtol=0, atol=1e-15)
+
+
+def test_from_physical():
+    m = np.array([2.0, np.inf])
+    inertia = np.array([[1.0, 1.0], [2.0, 1.0], [np.inf, 1.0]])
+    q = np.array([[2.0, 1.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    p = np.zeros((3, 2))
+    bodies = collide.from_physical(m, inertia, q, p, dtype=np.float64)
+    assert list(bodies.inv_mass) == [0.5, 0.0]
+    assert list(bodies.inv_inertia[:, 0]) == [1.0, 0.5, 0.0]
+    assert list(bodies.inv_inertia[:, 1]) == [0.0, 0.0, 0.0]  # immovable: no rotation either
+    assert list(bodies.q[:, 0]) == [1.0, 0.0, 0.0, 0.0]
+    with pytest.raises(ValueError, match=r"m\[0\]"):
+        collide.from_physical(np.array([-1.0]), np.ones((3, 1)), q[:, :1].copy(), np.zeros((3, 1)))
+
+
+def test_report_quick_rows():
+    rows = collide.report(n=2000, sample=500, runs=1, threads=[1], quick=True)
+    assert rows and {"scene", "variant", "model", "precision", "max_err_eps", "collisions_per_second"} <= set(rows[0])
+    kernel = [r for r in rows if r["variant"] in ("scalar", "simd")]
+    assert kernel and all(r["max_err_eps"] <= collide.error_bound_eps for r in kernel)
+    assert {r["scene"] for r in rows} == {"pairs", "debris"}
+    with pytest.raises(ValueError, match="runs"):
+        collide.report(n=10, runs=0)

@@ -1,0 +1,49 @@
+"""Builds the extension collide._collide with CMake for `pip install .`.
+
+Only the library and the module are built (no tests, benchmarks, CLI or
+examples), in Release, with ccache when it is on PATH, for the interpreter
+running pip. The build directory is build/pip-<python tag> under the source
+tree (kept between installs, so a second install recompiles only what
+changed); COLLIDE_PIP_BUILD_DIR overrides it.
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+ROOT = os.path.dirname(os.path.abspath(__file__))
+
+
+class CMakeExtension(Extension):
+    def __init__(self, name):
+        super().__init__(name, sources=[])
+
+
+class CMakeBuild(build_ext):
+    def build_extension(self, ext):
+        tag = sysconfig.get_config_var("SOABI") or "py"
+        build_dir = os.environ.get("COLLIDE_PIP_BUILD_DIR", os.path.join(ROOT, "build", "pip-" + tag))
+        configure = [
+            "cmake", "-S", ROOT, "-B", build_dir,
+            "-DCMAKE_BUILD_TYPE=Release",
+            "-DCOLLIDE_BUILD_TESTS=OFF", "-DCOLLIDE_BUILD_BENCH=OFF", "-DCOLLIDE_BUILD_CLI=OFF",
+            "-DCOLLIDE_BUILD_EXAMPLES=OFF", "-DCOLLIDE_INSTALL=OFF", "-DCOLLIDE_BUILD_PYTHON=ON",
+            "-DPYTHON_EXECUTABLE=" + sys.executable, "-DPython_EXECUTABLE=" + sys.executable,
+        ]
+        if shutil.which("ccache"):
+            configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
+        subprocess.check_call(configure)
+        jobs = str(os.cpu_count() or 1)
+        subprocess.check_call(["cmake", "--build", build_dir, "--target", "_collide", "-j", jobs])
+        built = os.path.join(build_dir, "python", "collide", os.path.basename(self.get_ext_filename(ext.name)))
+        target = self.get_ext_fullpath(ext.name)
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copyfile(built, target)
+
+
+setup(ext_modules=[CMakeExtension("collide._collide")], cmdclass={"build_ext": CMakeBuild})
