@@ -95,6 +95,7 @@
 #include "collide/solve.hpp"
 #include "collide/traffic.hpp"
 #include "memory_twin.hpp"
+#include "packed_twin.hpp"
 #include "support.hpp"
 #include "textbook.hpp"
 
@@ -428,6 +429,10 @@ double layout_solve(benchmark::State& state, Prepared<T>& p, const collide::Solv
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
   if (layout != LayoutRow::records) {
+    // One untimed solve sizes the solver's buffers (packing, ordered
+    // contacts): a frame loop pays that once, not per frame.
+    p.reset_for_solve();
+    solver.solve(model, bodies, contacts, impulses, p.schedule);
     return timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
   }
   collide::PackedBuffer<Record> records(bodies.count);
@@ -497,6 +502,30 @@ void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model 
   columns.threads = threads;
   set_counters(state, columns);
   state.SetLabel("memory only");
+}
+
+/// The packed layout's memory-only twin (packed_twin.hpp) on the scene of the
+/// layout rows: the ceiling of `layout/.../records` rows.
+template <class T>
+void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, int threads) {
+  Prepared<T>& p = g_cache.get<T>(kind, n, collide::Model::rigid, false);
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  const collide::BodyView<T> bodies = p.bodies();
+  collide::PackedBuffer<collide::PackedRigid<T>> records(bodies.count);
+  collide::pack(bodies, collide::packed_view(records));
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  packed_twin_pass<T>(arena, collide::packed_view(records), contacts, impulses, p.schedule);  // sizes its buffers
+  const double seconds = timed_solves(
+      state, p, [&] { packed_twin_pass<T>(arena, collide::packed_view(records), contacts, impulses, p.schedule); });
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(collide::Model::rigid, sizeof(T), false));
+  columns.seconds = seconds;
+  columns.threads = threads;
+  set_counters(state, columns);
+  state.SetLabel("memory only, packed");
 }
 
 template <class T>
@@ -601,6 +630,13 @@ void register_models(Kind kind, std::size_t n) {
         for (const int threads : {1, 2}) {
           add_row(layout_name(kind, model, friction, precision_name<T>(), layout, threads, n),
                   [=](benchmark::State& s) { layout_row<T>(s, kind, n, model, friction, threads, layout); });
+        }
+      }
+      if (model == collide::Model::rigid && !friction) {
+        for (const int threads : {1, 2}) {
+          add_row(std::string("twin/packed/") + kind_name(kind) + "/rigid/" + precision_name<T>() +
+                      "/t:" + std::to_string(threads) + "/n:" + std::to_string(n),
+                  [=](benchmark::State& s) { packed_twin_row<T>(s, kind, n, threads); });
         }
       }
       // The layout's ceiling, on the scene the rows above just used.
@@ -836,6 +872,28 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     if (collide::isa_supported(Isa::avx2)) {
       target("pairs f32 t:1 n:64Ki, avx2 / sse2", ratio(Kind::pairs, Isa::avx2, Isa::sse2, 1, cache_n), 1.0, "x");
     }
+  }
+  {
+    // Issue 11: scattered scenes on the packed layout.
+    using collide::Model;
+    auto per_s = [&](const std::string& name) {
+      const Result r = rep.get(name);
+      return r.valid ? r.coll_per_s : 0.0;
+    };
+    auto ratio = [](double a, double b) { return a > 0 && b > 0 ? a / b : 0.0; };
+    for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+      const std::string m = collide::to_string(model);
+      const double records =
+          per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
+      const double pairs = per_s(model_name(Kind::pairs, model, false, f32, 2, stream_n));
+      target(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), 0.5, "");
+    }
+    const double records = per_s(layout_name(Kind::debris, Model::rigid, false, f32, LayoutRow::records, 2, stream_n));
+    const double twin = per_s(std::string("twin/packed/debris/rigid/f32/t:2/n:") + std::to_string(stream_n));
+    target("debris rigid f32 t:2 n:4Mi, packed records / its memory-only twin", ratio(records, twin), 0.7, "");
+    const double simd = per_s(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));
+    const double scalar = per_s(solve_name(Kind::debris, f32, Path::scalar, 2, stream_n));
+    target("debris f32 t:2 n:4Mi (SoA input, automatic layout), simd / scalar", ratio(simd, scalar), 3.0, "x");
   }
   {
     const Result d = rep.get(solve_name(Kind::debris, f32, Path::simd, 2, stream_n));

@@ -51,9 +51,12 @@ install(TARGETS collide EXPORT collideTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# collide/report.hpp belongs to the report engine (collide_report, not
+# installed: it links Eigen and optionally Bullet), so it is left out.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/kernel/include/collide
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-  FILES_MATCHING PATTERN "*.hpp")
+  FILES_MATCHING PATTERN "*.hpp"
+  PATTERN "report.hpp" EXCLUDE)
 
 # The command-line tool, when built. A shared build finds its library relative
 # to its own location, so the installed tree can be moved.

@@ -6,11 +6,26 @@
 // Design notes
 // ------------
 // * This file is the simulation a user of the library writes; collide only
-//   resolves contacts. The bodies live in the example's own arrays
-//   (structure of arrays, the layout collide reads), wrapped once in a
-//   collide::SphereView: spheres have isotropic inertia, and a particle is a
+//   resolves contacts. Spheres have isotropic inertia, and a particle is a
 //   small sphere with inverse inertia 0 (it never spins), so the sphere model
 //   is the law for both and orientation is never stored.
+// * The bodies live in collide's packed layout (collide/packed.hpp), one
+//   64-byte collide::PackedSphere<float> record per body holding v, w, p,
+//   inverse mass and inverse inertia, for the whole run. Why packed: the
+//   contacts come from the broadphase, ordered by height, not by body, so
+//   the solver reaches bodies at random; in separate arrays per component
+//   that is a cache line per component per body, in a record it is one line
+//   (collide/packed.hpp). Why for the whole run: the records are the
+//   simulation's state, not a copy of it. Gravity, the broadphase, position
+//   correction, integration, the energy and the picture read and write the
+//   records, and the solver writes v and w into them in place, so nothing is
+//   packed or unpacked per step (handing collide SoA views would have it pack
+//   and unpack on every solve of a scattered scene).
+// * Side arrays, indexed like the records, hold what collide does not read:
+//   the radius (broadphase, picture), mass and moment of inertia (energy, in
+//   double). One exception: Schedule::build reads inverse masses from a plain
+//   array, so the example keeps a copy of them, written once with the records
+//   (masses never change).
 // * One step, symplectic Euler:
 //     1. v += g dt                        (gravity)
 //     2. contacts from penetration        (uniform grid over the bodies)
@@ -56,12 +71,14 @@
 
 #include <collide/bodies.hpp>
 #include <collide/contacts.hpp>
+#include <collide/packed.hpp>
 #include <collide/schedule.hpp>
 #include <collide/solve.hpp>
 
 namespace {
 
-using Real = float;  // what collide solves in: 8 lanes with AVX2
+using Real = float;                        // what collide solves in: 8 lanes with AVX2, 16 with AVX-512
+using Body = collide::PackedSphere<Real>;  // v, w, p, inverse mass, inverse inertia
 constexpr double kGravity = 9.81;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -151,34 +168,30 @@ bool parse(int argc, char** argv, Options& o) {
 // The world: body 0 is the ground, the plane z = 0 (immovable: inverse mass 0).
 // ---------------------------------------------------------------------------
 struct World {
-  std::vector<Real> inv_mass, inv_inertia, radius;
-  std::vector<Real> px, py, pz, vx, vy, vz, wx, wy, wz;
-  std::vector<double> mass, inertia;  // for the energy
-  std::size_t spheres = 0;            // bodies 1..spheres are spheres, the rest particles
+  collide::PackedBuffer<Body> bodies;  // the state collide reads, and v, w it writes
+  std::vector<Real> radius;            // [m]
+  std::vector<double> mass, inertia;   // [kg], [kg m^2], for the energy
+  std::vector<Real> inv_mass;          // [1/kg], a copy of bodies[i].inv_mass for Schedule::build
+  std::size_t spheres = 0;             // bodies 1..spheres are spheres, the rest particles
 
-  [[nodiscard]] std::size_t size() const { return inv_mass.size(); }
+  [[nodiscard]] std::size_t size() const { return bodies.size(); }
 
   void add(double m, double moment, double r, double x, double y, double z) {
+    Body body{};  // at rest
+    body.p[0] = static_cast<Real>(x);
+    body.p[1] = static_cast<Real>(y);
+    body.p[2] = static_cast<Real>(z);
+    body.inv_mass = std::isinf(m) ? Real(0) : static_cast<Real>(1 / m);
+    body.inv_inertia = std::isinf(moment) ? Real(0) : static_cast<Real>(1 / moment);
+    bodies.push_back(body);
+    radius.push_back(static_cast<Real>(r));
     mass.push_back(m);
     inertia.push_back(moment);
-    inv_mass.push_back(std::isinf(m) ? Real(0) : static_cast<Real>(1 / m));
-    inv_inertia.push_back(std::isinf(moment) ? Real(0) : static_cast<Real>(1 / moment));
-    radius.push_back(static_cast<Real>(r));
-    for (auto* field : {&px, &py, &pz, &vx, &vy, &vz, &wx, &wy, &wz}) field->push_back(0);
-    px.back() = static_cast<Real>(x);
-    py.back() = static_cast<Real>(y);
-    pz.back() = static_cast<Real>(z);
+    inv_mass.push_back(body.inv_mass);
   }
 
-  /// The caller's arrays as collide sees them; nothing is copied.
-  collide::SphereView<Real> view() {
-    return {size(),
-            inv_mass.data(),
-            inv_inertia.data(),
-            {px.data(), py.data(), pz.data()},
-            {vx.data(), vy.data(), vz.data()},
-            {wx.data(), wy.data(), wz.data()}};
-  }
+  /// The records as collide sees them; nothing is copied.
+  collide::PackedView<Body> view() { return collide::packed_view(bodies); }
 };
 
 constexpr double kDensity = 1000;  // [kg/m^3]
@@ -211,15 +224,16 @@ World make_world(const Options& o) {
       if (kind[static_cast<std::size_t>(s)] != pass) continue;
       const double x = (s % side - 0.5 * (side - 1)) * spacing + 0.1 * spacing * (unit(rng) - 0.5);
       const double y = ((s / side) % side - 0.5 * (side - 1)) * spacing + 0.1 * spacing * (unit(rng) - 0.5);
-      const double z = kSphereRadius[1] * 1.5 + (s / (side * side)) * spacing;
+      const double z = kSphereRadius[1] * 1.5 + static_cast<double>(s / (side * side)) * spacing;  // layer
       const double r =
           pass == 0 ? kSphereRadius[0] + (kSphereRadius[1] - kSphereRadius[0]) * unit(rng) : kParticleRadius;
       const double m = kDensity * 4.0 / 3.0 * kPi * r * r * r;
       // A particle has no rotational state: infinite moment, inverse 0.
       const double moment = pass == 0 ? 0.4 * m * r * r : inf;
       world.add(m, moment, r, x, y, z);
-      world.vx.back() = static_cast<Real>(0.5 * (unit(rng) - 0.5));
-      world.vy.back() = static_cast<Real>(0.5 * (unit(rng) - 0.5));
+      Body& body = world.bodies.back();
+      body.v[0] = static_cast<Real>(0.5 * (unit(rng) - 0.5));
+      body.v[1] = static_cast<Real>(0.5 * (unit(rng) - 0.5));
     }
   }
   return world;
@@ -292,9 +306,10 @@ class UniformGrid {
     // Ground contacts: anything reaching below z = 0. The ground is side b,
     // its normal +z; the contact point is the middle of the overlap.
     for (std::size_t i = 1; i < n; ++i) {
-      const double overlap = w.radius[i] - w.pz[i];
+      const Real* p = w.bodies[i].p;
+      const double overlap = w.radius[i] - p[2];
       if (overlap > 0) {
-        const double c[3] = {w.px[i], w.py[i], -0.5 * overlap};
+        const double c[3] = {p[0], p[1], -0.5 * overlap};
         const double up[3] = {0, 0, 1};
         out.add(static_cast<collide::BodyIndex>(i), 0, c, up, overlap, friction);
       }
@@ -304,7 +319,8 @@ class UniformGrid {
     bucket(w);
     pairs_.clear();
     for (std::size_t i = 1; i < n; ++i) {
-      const int cx = cell_coord(w.px[i], 0), cy = cell_coord(w.py[i], 1), cz = cell_coord(w.pz[i], 2);
+      const Real* p = w.bodies[i].p;
+      const int cx = cell_coord(p[0], 0), cy = cell_coord(p[1], 1), cz = cell_coord(p[2], 2);
       for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, dims_[2] - 1); ++z) {
         for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, dims_[1] - 1); ++y) {
           for (int x = std::max(cx - 1, 0); x <= std::min(cx + 1, dims_[0] - 1); ++x) {
@@ -319,14 +335,16 @@ class UniformGrid {
     }
     // Bottom of the pile first: support travels up in a single pass.
     std::sort(pairs_.begin(), pairs_.end(), [](const Pair& p, const Pair& q) { return p.z < q.z; });
-    for (const Pair& p : pairs_) {
-      const double dx = w.px[p.i] - w.px[p.j], dy = w.py[p.i] - w.py[p.j], dz = w.pz[p.i] - w.pz[p.j];
+    for (const Pair& pair : pairs_) {
+      const Real* pi = w.bodies[pair.i].p;
+      const Real* pj = w.bodies[pair.j].p;
+      const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
       const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-      const double overlap = w.radius[p.i] + w.radius[p.j] - d;
+      const double overlap = w.radius[pair.i] + w.radius[pair.j] - d;
       const double nrm[3] = {dx / d, dy / d, dz / d};  // from j towards i
-      const double reach = w.radius[p.j] - 0.5 * overlap;
-      const double c[3] = {w.px[p.j] + nrm[0] * reach, w.py[p.j] + nrm[1] * reach, w.pz[p.j] + nrm[2] * reach};
-      out.add(p.i, p.j, c, nrm, overlap, friction);
+      const double reach = w.radius[pair.j] - 0.5 * overlap;
+      const double c[3] = {pj[0] + nrm[0] * reach, pj[1] + nrm[1] * reach, pj[2] + nrm[2] * reach};
+      out.add(pair.i, pair.j, c, nrm, overlap, friction);
     }
   }
 
@@ -343,12 +361,11 @@ class UniformGrid {
       lo_[a] = std::numeric_limits<double>::infinity();
       hi_[a] = -std::numeric_limits<double>::infinity();
     }
-    const std::vector<Real>* p[3] = {&w.px, &w.py, &w.pz};
     for (std::size_t i = 1; i < n; ++i) {
       max_radius = std::max<double>(max_radius, w.radius[i]);
       for (int a = 0; a < 3; ++a) {
-        lo_[a] = std::min<double>(lo_[a], (*p[a])[i]);
-        hi_[a] = std::max<double>(hi_[a], (*p[a])[i]);
+        lo_[a] = std::min<double>(lo_[a], w.bodies[i].p[a]);
+        hi_[a] = std::max<double>(hi_[a], w.bodies[i].p[a]);
       }
     }
     // A body thrown far away would make a dense grid huge: cells grow until
@@ -367,7 +384,8 @@ class UniformGrid {
     cell_of_.resize(n);
     start_.assign(cells + 1, 0);
     for (std::size_t i = 1; i < n; ++i) {
-      cell_of_[i] = index(cell_coord(w.px[i], 0), cell_coord(w.py[i], 1), cell_coord(w.pz[i], 2));
+      const Real* p = w.bodies[i].p;
+      cell_of_[i] = index(cell_coord(p[0], 0), cell_coord(p[1], 1), cell_coord(p[2], 2));
       ++start_[cell_of_[i] + 1];
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
@@ -377,10 +395,12 @@ class UniformGrid {
   }
 
   void test_pair(const World& w, std::uint32_t i, std::uint32_t j) {
-    const double dx = w.px[i] - w.px[j], dy = w.py[i] - w.py[j], dz = w.pz[i] - w.pz[j];
+    const Real* pi = w.bodies[i].p;
+    const Real* pj = w.bodies[j].p;
+    const double dx = pi[0] - pj[0], dy = pi[1] - pj[1], dz = pi[2] - pj[2];
     const double r = w.radius[i] + w.radius[j];
     const double d2 = dx * dx + dy * dy + dz * dz;
-    if (d2 < r * r && d2 > 0) pairs_.push_back({i, j, std::min(w.pz[i], w.pz[j])});
+    if (d2 < r * r && d2 > 0) pairs_.push_back({i, j, std::min(pi[2], pj[2])});
   }
 
   [[nodiscard]] int cell_coord(double x, int axis) const {
@@ -408,11 +428,12 @@ struct Energy {
 Energy energy(const World& w) {
   Energy e;
   for (std::size_t i = 1; i < w.size(); ++i) {
-    const double v2 = double(w.vx[i]) * w.vx[i] + double(w.vy[i]) * w.vy[i] + double(w.vz[i]) * w.vz[i];
-    const double w2 = double(w.wx[i]) * w.wx[i] + double(w.wy[i]) * w.wy[i] + double(w.wz[i]) * w.wz[i];
+    const Body& b = w.bodies[i];
+    const double v2 = double(b.v[0]) * b.v[0] + double(b.v[1]) * b.v[1] + double(b.v[2]) * b.v[2];
+    const double w2 = double(b.w[0]) * b.w[0] + double(b.w[1]) * b.w[1] + double(b.w[2]) * b.w[2];
     e.kinetic += 0.5 * w.mass[i] * v2;
-    if (w.inv_inertia[i] > 0) e.rotational += 0.5 * w.inertia[i] * w2;
-    e.potential += w.mass[i] * kGravity * w.pz[i];
+    if (b.inv_inertia > 0) e.rotational += 0.5 * w.inertia[i] * w2;
+    e.potential += w.mass[i] * kGravity * b.p[2];
   }
   return e;
 }
@@ -428,15 +449,16 @@ double correct_positions(World& w, const Contacts& c) {
   for (std::size_t k = 0; k < c.size(); ++k) {
     const double excess = c.depth[k] - kSlop;
     if (excess <= 0) continue;
-    const std::uint32_t a = c.a[k], b = c.b[k];
-    const double wa = w.inv_mass[a], wb = w.inv_mass[b];
+    Body& a = w.bodies[c.a[k]];
+    Body& b = w.bodies[c.b[k]];
+    const double wa = a.inv_mass, wb = b.inv_mass;
     const double s = kFraction * excess / (wa + wb);
-    w.px[a] += static_cast<Real>(s * wa * c.nx[k]);
-    w.py[a] += static_cast<Real>(s * wa * c.ny[k]);
-    w.pz[a] += static_cast<Real>(s * wa * c.nz[k]);
-    w.px[b] -= static_cast<Real>(s * wb * c.nx[k]);
-    w.py[b] -= static_cast<Real>(s * wb * c.ny[k]);
-    w.pz[b] -= static_cast<Real>(s * wb * c.nz[k]);
+    a.p[0] += static_cast<Real>(s * wa * c.nx[k]);
+    a.p[1] += static_cast<Real>(s * wa * c.ny[k]);
+    a.p[2] += static_cast<Real>(s * wa * c.nz[k]);
+    b.p[0] -= static_cast<Real>(s * wb * c.nx[k]);
+    b.p[1] -= static_cast<Real>(s * wb * c.ny[k]);
+    b.p[2] -= static_cast<Real>(s * wb * c.nz[k]);
     // m g dz for both sides; m * (s * w) = s for a movable body.
     lifted += kGravity * s * c.nz[k] * ((wa > 0 ? 1 : 0) - (wb > 0 ? 1 : 0));
   }
@@ -463,7 +485,8 @@ bool write_png(const std::string& path, const std::vector<StepRecord>& history, 
   }
   std::fprintf(gp, "EOD\n$pile << EOD\n");
   for (std::size_t i = 1; i < w.size(); ++i) {
-    std::fprintf(gp, "%g %g %g %g\n", w.px[i], w.py[i], w.radius[i], w.pz[i]);
+    const Real* p = w.bodies[i].p;
+    std::fprintf(gp, "%g %g %g %g\n", p[0], p[1], w.radius[i], p[2]);
   }
   std::fprintf(gp, "EOD\n");
   std::fputs(
@@ -522,16 +545,17 @@ int main(int argc, char** argv) {
   for (int step = 1; step <= o.steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
     const Real dv = static_cast<Real>(kGravity * o.dt);
-    for (std::size_t i = 1; i < world.size(); ++i) world.vz[i] -= dv;
+    for (std::size_t i = 1; i < world.size(); ++i) world.bodies[i].v[2] -= dv;
 
     grid.find_contacts(world, o.friction, contacts);
     const collide::ContactView<Real> view = contacts.view(o.restitution);
     const collide::ImpulseView<Real> impulses = contacts.impulses();
-    const collide::SphereView<Real> bodies = world.view();
+    const collide::PackedView<Body> bodies = world.view();
 
-    // collide: one schedule for this step's contacts, several passes over it.
+    // collide: one schedule for this step's contacts, several passes over it,
+    // each writing v and w into the records in place.
     const auto s0 = std::chrono::steady_clock::now();
-    schedule.build(view, bodies.count, bodies.inv_mass);
+    schedule.build(view, bodies.count, world.inv_mass.data());
     std::size_t resolved = 0;
     for (int pass = 0; pass < o.passes; ++pass) {
       stats = solver.solve(bodies, view, impulses, schedule);
@@ -550,9 +574,10 @@ int main(int argc, char** argv) {
     lifted += correct_positions(world, contacts);
     const Real dt = static_cast<Real>(o.dt);
     for (std::size_t i = 1; i < world.size(); ++i) {
-      world.px[i] += world.vx[i] * dt;
-      world.py[i] += world.vy[i] * dt;
-      world.pz[i] += world.vz[i] * dt;
+      Body& b = world.bodies[i];
+      b.p[0] += b.v[0] * dt;
+      b.p[1] += b.v[1] * dt;
+      b.p[2] += b.v[2] * dt;
     }
 
     const Energy e = energy(world);

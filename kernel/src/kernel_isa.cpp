@@ -209,7 +209,7 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
 /// groups of W; returns where the groups stopped (the tail, fewer than W
 /// contacts, is the caller's).
 ///
-/// On the packed layout with contacts in random order, the records of the
+/// On the packed layout, the records of the
 /// contacts kPrefetchAhead positions ahead are requested before each group:
 /// a record is one to three lines, so the requests are few and the misses
 /// overlap instead of waiting one after another.
@@ -222,7 +222,7 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* 
   constexpr std::size_t W = V::size();
   std::size_t i = begin;
   if constexpr (!kSoaLayout<View>) {
-    if (!contiguous && W > 1) {
+    if (W > 1) {
       const std::size_t warm = std::min(end, begin + kPrefetchAhead);
       for (std::size_t k = begin; k < warm; ++k) {
         prefetch_record(records, contacts.a[order[k]]);

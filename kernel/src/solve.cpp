@@ -31,6 +31,7 @@
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
 #include "kernel_table.hpp"
+#include "ordered_contacts.hpp"
 #include "scratch_records.hpp"
 
 namespace collide {
@@ -50,6 +51,18 @@ struct Solver::Impl {
   detail::ScratchRecords<PackedSphere<double>> sphere_d;
   detail::ScratchRecords<PackedParticle<float>> particle_f;
   detail::ScratchRecords<PackedParticle<double>> particle_d;
+
+  detail::OrderedContacts<float> ordered_f;
+  detail::OrderedContacts<double> ordered_d;
+
+  template <class T>
+  detail::OrderedContacts<T>& ordered() {
+    if constexpr (std::is_same_v<T, float>) {
+      return ordered_f;
+    } else {
+      return ordered_d;
+    }
+  }
 
   template <class Record>
   detail::ScratchRecords<Record>& buffer() {
@@ -142,7 +155,8 @@ std::size_t simd_lanes(const KernelTable& table) {
 /// Walks the batches of the schedule; blocks of a large batch run in parallel.
 template <class T>
 SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb::task_arena& arena,
-                        const KernelJob<T>& job, std::size_t body_count, const Schedule& schedule) {
+                        const KernelJob<T>& job, std::size_t body_count, const Schedule& schedule,
+                        bool in_schedule_order = false) {
   assert(schedule.contact_count() == job.contacts.count);
   assert(schedule.body_count() == body_count);
   assert(job.impulses.count == job.contacts.count);
@@ -157,7 +171,9 @@ SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb:
     for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
       const std::size_t begin = schedule.batch_begin(k);
       const std::size_t end = schedule.batch_begin(k + 1);
-      const bool contiguous = schedule.batch_is_contiguous(k);
+      // Contacts copied into schedule order (OrderedContacts) make every
+      // batch a consecutive range of the copy.
+      const bool contiguous = in_schedule_order || schedule.batch_is_contiguous(k);
       const std::size_t n = end - begin;
       if (n < 2 * block || arena.max_concurrency() == 1) {
         kernel(job, contiguous, begin, end);
@@ -226,6 +242,11 @@ std::size_t scattered_contacts(const Schedule& schedule) {
 /// (README, "Performance"): at a quarter as many scattered contacts as
 /// bodies the two cost about the same; below that, or in scenes that stream
 /// (pairs), the SoA arrays are used in place.
+/// Scattered contacts above which a packed solve copies the contacts into
+/// schedule order (ordered_contacts.hpp): below, the copy costs more than the
+/// scattered reads it saves.
+constexpr std::size_t kOrderContactsAbove = 4096;
+
 bool should_pack(BodyLayout layout, const Schedule& schedule, std::size_t bodies) {
   switch (layout) {
     case BodyLayout::soa:
@@ -275,8 +296,28 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   impl_->arena->execute([&] { pack(bodies, packed); });
   job.packed = true;
   detail::set_packed(job, packed);
-  SolveStats stats = detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
+  SolveStats stats = run_packed(job, bodies.count, schedule);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
+  return stats;
+}
+
+/// The kernel on packed bodies (the mutex is held). Scattered contacts are
+/// copied into schedule order first (ordered_contacts.hpp), so that the
+/// kernel streams them, and J is put back into input order after.
+template <class T>
+SolveStats Solver::run_packed(detail::KernelJob<T> job, std::size_t body_count, const Schedule& schedule) const {
+  if (detail::scattered_contacts(schedule) < detail::kOrderContactsAbove) {
+    return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, body_count, schedule);
+  }
+  detail::OrderedContacts<T>& ordered = impl_->ordered<T>();
+  const std::size_t n = job.contacts.count;
+  const ImpulseView<T> out = job.impulses;
+  impl_->arena->execute([&] { job.contacts = ordered.gather(job.contacts, schedule.order()); });
+  job.impulses = ordered.impulses(n);
+  job.order = ordered.identity(n);
+  SolveStats stats =
+      detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, body_count, schedule, true);
+  impl_->arena->execute([&] { ordered.scatter(job.impulses, out, schedule.order()); });
   return stats;
 }
 
@@ -286,7 +327,8 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
-  return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
+  const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
+  return run_packed(job, bodies.count, schedule);
 }
 
 template <class T>

@@ -19,6 +19,10 @@
 #include "collide/schedule.hpp"
 
 namespace collide {
+namespace detail {
+template <class T>
+struct KernelJob;
+}  // namespace detail
 
 /// Which implementation of the kernel runs.
 enum class Path {
@@ -164,6 +168,8 @@ class Solver {
   template <class Record, class View, class T>
   SolveStats solve_soa(Model model, const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                        const Schedule& schedule) const;
+  template <class T>
+  SolveStats run_packed(detail::KernelJob<T> job, std::size_t body_count, const Schedule& schedule) const;
   template <class Record, class T>
   SolveStats solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                           const ImpulseView<T>& impulses, const Schedule& schedule) const;

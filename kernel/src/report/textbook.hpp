@@ -1,4 +1,4 @@
-// cli/textbook.hpp - the baseline: the loop a user would write from the law.
+// report/textbook.hpp - the baseline: the loop a user would write from the law.
 //
 // Design notes
 // ------------
@@ -29,7 +29,7 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 
-namespace collide::cli {
+namespace collide::report_detail {
 
 template <class T>
 void textbook_solve(const collide::BodyView<T>& bodies, const collide::ContactView<T>& contacts,
@@ -105,4 +105,4 @@ void textbook_solve(const collide::BodyView<T>& bodies, const collide::ContactVi
   }
 }
 
-}  // namespace collide::cli
+}  // namespace collide::report_detail

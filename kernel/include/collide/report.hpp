@@ -1,6 +1,8 @@
-// cli/report.hpp - what the parts of `collide report` share: the rows it
-// measures, the machine facts it states, and the writers of the table, the
-// JSON and the plot.
+// collide/report.hpp - the report engine: speed against error of every
+// variant of the solver (and the reference, the textbook loop, the Bullet
+// peer) on the pairs and the debris scene, as rows, and the writers of the
+// table, the JSON and the plot. `collide report` and collide.report() in
+// Python are thin shells over it.
 //
 // Design notes
 // ------------
@@ -9,22 +11,18 @@
 //   on an error sample). The same struct feeds the table, the JSON and the
 //   plot, so the three can never disagree.
 // * The peer (Bullet) lives in its own translation unit behind
-//   COLLIDE_WITH_BULLET, so the report builds and runs without it; the
-//   measuring helpers it shares with the kernel rows (error statistics,
-//   momentum and energy) are declared here.
+//   COLLIDE_WITH_BULLET (src/report/bullet_row.cpp), so the report builds
+//   and runs without it. The engine is its own library (collide_report), so
+//   the core library links neither Bullet nor Eigen.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "collide/bodies.hpp"
-#include "collide/contacts.hpp"
-#include "collide/reference.hpp"
-#include "collide/scene.hpp"
-
-namespace collide::cli {
+namespace collide {
 
 /// One measured variant.
 struct ReportRow {
@@ -92,65 +90,38 @@ struct Report {
 };
 
 // ---------------------------------------------------------------------------
-// Error against the reference (cmd_report.cpp).
+// The run (src/report/run_report.cpp).
 // ---------------------------------------------------------------------------
 
-/// Linear momentum, angular momentum about the origin (orbital p x m v plus
-/// spin), kinetic energy, and the scales the drifts are divided by. Locked
-/// axes (inverse moment 0) are left out of the spin terms: their spin never
-/// changes, and their moment is infinite.
-struct Totals {
-  long double p[3] = {0, 0, 0};
-  long double l[3] = {0, 0, 0};
-  long double energy = 0;
-  long double p_scale = 0;  ///< sum m |v|
-  long double l_scale = 0;  ///< sum |p x m v| + |I w|
+/// What to measure; the defaults are `collide report` without options.
+struct ReportOptions {
+  std::size_t n = 4000000;            ///< collisions of the pairs scene
+  std::vector<int> threads = {1, 2};  ///< thread counts of the kernel rows
+  std::size_t sample = 100000;        ///< contacts of the error sample
+  int runs = 5;                       ///< timed runs per row (the median is reported)
+  std::uint64_t seed = 1;             ///< scene seed
+  bool quick = false;                 ///< a smoke run: short triad, sample of at most n
+  std::size_t debris_n = 1000000;     ///< collisions of the debris scene
+  std::size_t slow_n = 500000;        ///< contacts of the slow (single-threaded, unvectorised) rows
+  std::vector<std::size_t> sweep_n;   ///< N of the throughput sweep; empty: no sweep
 };
-template <class T>
-Totals body_totals(const BodyView<const T>& bodies);
 
-/// The long double reference for one error sample.
-struct ReferenceResult {
-  ImpulseBuffer<long double> impulses;
-  std::vector<ReferenceContact<long double>> diagnostics;
-  Totals before, after;
-};
-/// Solves convert_scene<long double>(sample) with reference_solve<long double>.
-template <class T>
-ReferenceResult reference_of(const Scene<T>& sample);
-
-/// Fills the error columns of `row` from a variant's impulses and final
-/// bodies on the sample, in units of eps (the row's precision).
-template <class T>
-void fill_error(ReportRow& row, const ImpulseView<const T>& impulses, const BodyView<const T>& after,
-                const ReferenceResult& reference, double eps);
-
-/// Median of a list of run times.
-double median(std::vector<double> values);
-
-// ---------------------------------------------------------------------------
-// The peer (cmd_report_bullet.cpp, only with COLLIDE_WITH_BULLET).
-// ---------------------------------------------------------------------------
-
-/// "bullet <version>" when the peer is compiled in, "" otherwise.
-std::string bullet_version();
-/// Measures btSequentialImpulseConstraintSolver on the first `n` contacts of
-/// the pairs scene `scene` (frictionless, float), `runs` timed runs, and on
-/// the error sample.
-ReportRow bullet_row(const Scene<float>& scene, std::size_t n, const Scene<float>& sample,
-                     const ReferenceResult& reference, int runs, double triad_bytes_per_second);
+/// Measures every row (and the sweep) and returns them in canonical order
+/// (sort_report_rows). Progress goes to stderr only when it is a terminal.
+/// Throws std::invalid_argument for options out of range.
+Report measure_report(const ReportOptions& options);
 
 // ---------------------------------------------------------------------------
 // Output (report_output.cpp).
 // ---------------------------------------------------------------------------
 
 /// Puts the rows into the canonical order of the table and the JSON.
-void sort_rows(Report& report);
+void sort_report_rows(Report& report);
 /// The fixed-width table printed on stdout.
-std::string format_table(const Report& report);
+std::string format_report_table(const Report& report);
 /// The JSON document: {"machine": ..., "rows": [one object per row], "sweep": [...]}.
-std::string format_json(const Report& report);
+std::string format_report_json(const Report& report);
 /// Writes the PNG with gnuplot. Returns "" on success, or why it failed.
-std::string write_plot(const Report& report, const std::string& png_path);
+std::string write_report_plot(const Report& report, const std::string& png_path);
 
-}  // namespace collide::cli
+}  // namespace collide

@@ -1,4 +1,4 @@
-// cli/report_output.cpp - the table, the JSON and the plot of `collide report`.
+// report/report_output.cpp - the table, the JSON and the plot of `collide report`.
 //
 // Design notes
 // ------------
@@ -44,10 +44,10 @@
 
 #include "collide/error_bound.hpp"
 #include "collide/model.hpp"
+#include "collide/report.hpp"
 #include "collide/traffic.hpp"
-#include "report.hpp"
 
-namespace collide::cli {
+namespace collide {
 
 namespace {
 
@@ -102,7 +102,7 @@ std::string label(const ReportRow& r) {
 
 }  // namespace
 
-void sort_rows(Report& report) {
+void sort_report_rows(Report& report) {
   auto key = [](const ReportRow& r) {
     const bool kernel = r.variant == "scalar" || r.variant == "simd";
     return std::make_tuple(r.scene == "pairs" ? 0 : 1, r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant),
@@ -116,7 +116,7 @@ void sort_rows(Report& report) {
 // Table.
 // ---------------------------------------------------------------------------
 
-std::string format_table(const Report& report) {
+std::string format_report_table(const Report& report) {
   const MachineInfo& m = report.machine;
   std::string out;
   char line[512];
@@ -188,7 +188,7 @@ std::string format_table(const Report& report) {
 // JSON.
 // ---------------------------------------------------------------------------
 
-std::string format_json(const Report& report) {
+std::string format_report_json(const Report& report) {
   const MachineInfo& m = report.machine;
   std::string s = "{\n";
   s += "  \"command\": \"collide report\",\n";
@@ -328,7 +328,7 @@ std::string gp_string(const std::string& s) {
 
 }  // namespace
 
-std::string write_plot(const Report& report, const std::string& png_path) {
+std::string write_report_plot(const Report& report, const std::string& png_path) {
   if (!on_path("gnuplot")) {
     return "gnuplot is not installed (Debian package gnuplot-nox; scripts/install-deps.sh installs it)";
   }
@@ -492,4 +492,4 @@ std::string write_plot(const Report& report, const std::string& png_path) {
   return "";
 }
 
-}  // namespace collide::cli
+}  // namespace collide

@@ -1,10 +1,10 @@
-// cli/cmd_report_bullet.cpp - the peer row of `collide report`: Bullet's
+// report/bullet_row.cpp - the peer row of `collide report`: Bullet's
 // btSequentialImpulseConstraintSolver on the same pairs.
 //
 // Design notes
 // ------------
 // * Compiled only when CMake found Bullet with pkg-config (COLLIDE_WITH_BULLET);
-//   without it the report says so and has no peer row (cmd_report.cpp has the
+//   without it the report says so and has no peer row (measure.cpp has the
 //   stubs).
 // * Bullet is configured to compute our law as closely as it can: one
 //   iteration (the pairs share no body, so one sweep is exact), restitution
@@ -42,9 +42,9 @@
 #include <vector>
 
 #include "collide/traffic.hpp"
-#include "report.hpp"
+#include "measure.hpp"
 
-namespace collide::cli {
+namespace collide::report_detail {
 
 namespace {
 
@@ -213,4 +213,4 @@ ReportRow bullet_row(const Scene<float>& scene, std::size_t n, const Scene<float
   return row;
 }
 
-}  // namespace collide::cli
+}  // namespace collide::report_detail
