@@ -883,8 +883,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     auto ratio = [](double a, double b) { return a > 0 && b > 0 ? a / b : 0.0; };
     for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
       const std::string m = collide::to_string(model);
-      const double records =
-          per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
+      const double records = per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
       const double pairs = per_s(model_name(Kind::pairs, model, false, f32, 2, stream_n));
       target(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), 0.5, "");
     }

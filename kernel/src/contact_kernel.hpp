@@ -328,8 +328,8 @@ COLLIDE_LANE_INLINE BodyLanes<M, typename AccurateLanes<V>::type> widen_body(con
   }
   if constexpr (std::is_same_v<M, RigidModel>) {
     w.inv_inertia = widen(b.inv_inertia);
-    w.rotation = normalised_rotation(QuatLanes<typename A::type>{A::widen(b.q.w), A::widen(b.q.x), A::widen(b.q.y),
-                                                                  A::widen(b.q.z)});
+    w.rotation = normalised_rotation(
+        QuatLanes<typename A::type>{A::widen(b.q.w), A::widen(b.q.x), A::widen(b.q.y), A::widen(b.q.z)});
   } else if constexpr (std::is_same_v<M, SphereModel>) {
     w.inv_inertia.x = A::widen(b.inv_inertia.x);
   }

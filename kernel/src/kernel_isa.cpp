@@ -235,13 +235,14 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* 
           prefetch_record(records, contacts.b[order[k]]);
         }
         solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
-                                        ContactGroup{contiguous, order[i], order + i});
+                                              ContactGroup{contiguous, order[i], order + i});
       }
       return i;
     }
   }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
+                                          ContactGroup{contiguous, order[i], order + i});
   }
   return i;
 }
@@ -253,14 +254,14 @@ std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::s
     using M = decltype(model);
     constexpr bool kFriction = decltype(friction)::value;
     return solve_groups<M, V, kFriction, Mode, T>(view, static_cast<const char*>(nullptr), job.contacts, job.impulses,
-                                            job.order, contiguous, begin, end);
+                                                  job.order, contiguous, begin, end);
   };
   const auto run_packed = [&](const auto& packed, auto model, auto friction) {
     using M = decltype(model);
     constexpr bool kFriction = decltype(friction)::value;
     const PackedFields<std::remove_pointer_t<decltype(packed.bodies)>> fields(packed);
-    return solve_groups<M, V, kFriction, Mode, T>(fields, packed.bodies, job.contacts, job.impulses, job.order, contiguous,
-                                            begin, end);
+    return solve_groups<M, V, kFriction, Mode, T>(fields, packed.bodies, job.contacts, job.impulses, job.order,
+                                                  contiguous, begin, end);
   };
   const std::true_type with_friction;
   const std::false_type without;

@@ -126,9 +126,7 @@ struct RefBody {
   /// rounding of the large one: with a moment ratio of 1e-12 (a needle) the
   /// formed matrix was off by ~1e-7 relative even in long double, and the
   /// reference, not the kernel, was wrong.
-  V3 inv_inertia_world(const V3& x) const {
-    return rotation * inv_inertia.cwiseProduct(rotation.transposed_times(x));
-  }
+  V3 inv_inertia_world(const V3& x) const { return rotation * inv_inertia.cwiseProduct(rotation.transposed_times(x)); }
 
   RefBody(const BodyView<S>& bodies, std::size_t i) {
     inv_mass = bodies.inv_mass[i];

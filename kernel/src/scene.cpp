@@ -93,7 +93,8 @@ void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
   ix_[i] = immovable ? T(0) : inverse_or_zero(body.I[0]);
   iy_[i] = immovable ? T(0) : inverse_or_zero(body.I[1]);
   iz_[i] = immovable ? T(0) : inverse_or_zero(body.I[2]);
-  const T qn = scene_sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
+  const T qn =
+      scene_sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
   qw_[i] = body.q[0] / qn;
   qx_[i] = body.q[1] / qn;
   qy_[i] = body.q[2] / qn;

@@ -199,7 +199,8 @@ std::vector<double> time_runs(int runs, const Restore& restore, const Solve& sol
 using Config = ReportOptions;
 
 constexpr Model kModels[] = {Model::rigid, Model::sphere, Model::particle};
-constexpr Path kPaths[] = {Path::scalar, Path::simd};
+constexpr std::pair<Path, Accuracy> kKernelVariants[] = {
+    {Path::scalar, Accuracy::fast}, {Path::simd, Accuracy::fast}, {Path::simd, Accuracy::accurate}};
 
 class Runner {
  public:
@@ -265,19 +266,21 @@ class Runner {
   }
 
   [[nodiscard]] std::size_t expected_rows() const {
-    const std::size_t kernel = std::size_t{2 /*precisions*/ * 3 /*models*/ * 2 /*paths*/} * config_.threads.size();
+    const std::size_t kernel =
+        std::size_t{2 /*precisions*/ * 3 /*models*/ * 3 /*scalar, simd, accurate*/} * config_.threads.size();
     const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
     std::size_t rows = std::size_t{2 /*scenes*/ * 2 /*friction*/} * (kernel + slow);
     if (!bullet_version().empty()) ++rows;
     return rows;
   }
 
-  const Solver& solver(Path path, int threads) {
-    auto& slot = solvers_[{path == Path::simd ? 1 : 0, threads}];
+  const Solver& solver(Path path, int threads, Accuracy accuracy) {
+    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + (accuracy == Accuracy::accurate ? 2 : 0), threads}];
     if (!slot) {
       SolverOptions options;
       options.path = path;
       options.threads = threads;
+      options.accuracy = accuracy;
       slot = std::make_unique<Solver>(options);
     }
     return *slot;
@@ -358,10 +361,13 @@ class Runner {
         }
       }
 
-      for (const Path path : kPaths) {
+      // The scalar and SIMD paths, and the SIMD path in the accurate mode
+      // (issue 13) as the variant "accurate".
+      for (const auto& [path, accuracy] : kKernelVariants) {
         for (const int threads : config_.threads) {
-          const Solver& s = solver(path, threads);
-          ReportRow row = new_row(kind, to_string(path), model, precision_name<T>(), friction, threads, n);
+          const Solver& s = solver(path, threads, accuracy);
+          ReportRow row = new_row(kind, accuracy == Accuracy::accurate ? "accurate" : to_string(path), model,
+                                  precision_name<T>(), friction, threads, n);
           row.simd = path == Path::simd;
           progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
           const BodyView<T> bodies = scene.bodies.view();
