@@ -11,6 +11,7 @@
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
 //   then the body-model grid at 64Ki and 4Mi:
 //     model/<scene>/<model>[+mu]/<prec>/simd/t:{1,2}/n:N
+//     accurate/<scene>/<model>[+mu]/<prec>/simd/t:{1,2}/n:N   the same, Accuracy::accurate
 //     twin/pairs/<model>[+mu]/<prec>/t:{1,2}/n:N   the model's memory-only twin
 //                                    (memory_twin.hpp): the ceiling of its layout
 // Scenes: pairs (collide::generate_pairs: contact k joins bodies 2k, 2k+1),
@@ -390,11 +391,13 @@ void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int
 /// models read only their own arrays, so the bytes per collision are the
 /// model's own (collide/traffic.hpp).
 template <class T>
-void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads) {
+void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
+               collide::Accuracy accuracy = collide::Accuracy::fast) {
   Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
   collide::SolverOptions options;
   options.path = Path::simd;
   options.threads = threads;
+  options.accuracy = accuracy;
   const collide::Solver solver(options);
   const collide::BodyView<T> bodies = p.bodies();
   const collide::ContactView<T> contacts = p.contacts();
@@ -614,6 +617,14 @@ void register_models(Kind kind, std::size_t n) {
       for (const int threads : {1, 2}) {
         add_row(model_name(kind, model, friction, precision_name<T>(), threads, n),
                 [=](benchmark::State& s) { model_row<T>(s, kind, n, model, friction, threads); });
+      }
+      // The accurate mode (issue 13) on the same scene: its cost against the
+      // rows above.
+      for (const int threads : {1, 2}) {
+        add_row("accurate/" + model_name(kind, model, friction, precision_name<T>(), threads, n).substr(6),
+                [=](benchmark::State& s) {
+                  model_row<T>(s, kind, n, model, friction, threads, collide::Accuracy::accurate);
+                });
       }
       // Both layouts (issue 11), on the scene the rows above just used.
       for (const LayoutRow layout : {LayoutRow::soa, LayoutRow::packed, LayoutRow::records}) {
@@ -872,8 +883,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     auto ratio = [](double a, double b) { return a > 0 && b > 0 ? a / b : 0.0; };
     for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
       const std::string m = collide::to_string(model);
-      const double records =
-          per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
+      const double records = per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, stream_n));
       const double pairs = per_s(model_name(Kind::pairs, model, false, f32, 2, stream_n));
       target(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), 0.5, "");
     }

@@ -133,7 +133,7 @@ int run_report(int argc, char** argv) {
     }
   }
   for (const ReportRow& row : report.rows) {
-    const bool kernel = row.variant == "scalar" || row.variant == "simd";
+    const bool kernel = is_kernel_variant(row.variant);
     if (kernel && !(row.max_err_eps <= kImpulseErrorBoundEps)) {
       std::fprintf(stderr,
                    "collide report: %s %s %s %s: impulse error %.6g eps * impulse_scale exceeds the documented "

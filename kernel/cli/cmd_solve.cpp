@@ -51,6 +51,7 @@ const char* const kSolveUsage =
     "usage: collide solve --bodies B.csv --contacts C.csv --out-bodies OB.csv --out-impulses OJ.csv\n"
     "                     [--precision float|double] [--threads N] [--path simd|scalar]\n"
     "                     [--isa auto|sse2|avx2|avx512] [--layout auto|soa|packed]\n"
+    "                     [--accuracy fast|accurate]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
@@ -73,6 +74,9 @@ const char* const kSolveUsage =
     "  --isa I               instruction set of the simd path: auto (default: $COLLIDE_ISA,\n"
     "                        else the best this CPU has), sse2, avx2 or avx512;\n"
     "                        results do not depend on it\n"
+    "  --accuracy A          fast (default: plain arithmetic, within a few eps of the\n"
+    "                        impulse scale) or accurate (J within a few ulps of the\n"
+    "                        exact law, slower); both are deterministic\n"
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
@@ -98,6 +102,7 @@ struct SolveRequest {
   Path path = Path::simd;
   Isa isa = Isa::automatic;  // resolved in run_solve: never automatic when solving
   BodyLayout layout = BodyLayout::automatic;
+  Accuracy accuracy = Accuracy::fast;
   bool auto_model = true;
   Model model = Model::rigid;
   bool stats = false;
@@ -138,6 +143,7 @@ int solve_scene(const SolveRequest& req) {
   options.threads = req.threads;
   options.isa = req.isa;
   options.layout = req.layout;
+  options.accuracy = req.accuracy;
   const Solver solver(options);
   ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
@@ -215,6 +221,7 @@ int run_solve(int argc, char** argv) {
                                      {"path", true},
                                      {"isa", true},
                                      {"layout", true},
+                                     {"accuracy", true},
                                      {"model", true},
                                      {"stats", false},
                                      {"check", false}});
@@ -266,6 +273,13 @@ int run_solve(int argc, char** argv) {
       req.isa = resolve_isa(it == opt.end() ? Isa::automatic : parse_isa(it->second));
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string(it == opt.end() ? "" : "--isa: ") + e.what());
+    }
+  }
+  if (const auto it = opt.find("accuracy"); it != opt.end()) {
+    try {
+      req.accuracy = parse_accuracy(it->second);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--accuracy: ") + e.what());
     }
   }
   if (const auto it = opt.find("layout"); it != opt.end()) {

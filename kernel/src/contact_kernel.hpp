@@ -56,6 +56,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "exact_lanes.hpp"
 #include "lanes.hpp"
 
 namespace collide::detail {
@@ -68,13 +69,25 @@ struct RigidModel {};
 template <class M>
 inline constexpr bool kRotates = !std::is_same_v<M, ParticleModel>;
 
+/// How the law is evaluated (collide::Accuracy): FastMode in the lanes' own
+/// precision, AccurateMode in the wider lanes of exact_lanes.hpp.
+struct FastMode {};
+struct AccurateMode {};
+
+/// A rigid body's stored orientation (w, x, y, z), as read.
+template <class V>
+struct QuatLanes {
+  V w, x, y, z;
+};
+
 /// The state of the W bodies on one side of W contacts, gathered into lanes.
 /// Fields a model does not use are left unset and never read.
 template <class M, class V>
 struct BodyLanes {
   V inv_mass;           // [1/kg], 0 = immovable
   Vec3<V> inv_inertia;  // rigid: body frame [1/(kg m^2)]; sphere: x only
-  Mat3<V> rotation;     // rigid: body to world
+  Mat3<V> rotation;     // rigid: body to world, formed from q in the lanes' precision
+  QuatLanes<V> q;       // rigid: as stored (the accurate mode forms its own rotation)
   Vec3<V> p;            // [m] (sphere, rigid)
   Vec3<V> v;            // [m/s]
   Vec3<V> w;            // [rad/s] (sphere, rigid)
@@ -100,11 +113,11 @@ template <class M, class V>
 COLLIDE_LANE_INLINE void zero_immovable_inertia(BodyLanes<M, V>& body) {
   const auto immovable = body.inv_mass == V(0);
   if constexpr (std::is_same_v<M, RigidModel>) {
-    stdx::where(immovable, body.inv_inertia.x) = V(0);
-    stdx::where(immovable, body.inv_inertia.y) = V(0);
-    stdx::where(immovable, body.inv_inertia.z) = V(0);
+    body.inv_inertia.x = select(immovable, V(0), body.inv_inertia.x);
+    body.inv_inertia.y = select(immovable, V(0), body.inv_inertia.y);
+    body.inv_inertia.z = select(immovable, V(0), body.inv_inertia.z);
   } else if constexpr (std::is_same_v<M, SphereModel>) {
-    stdx::where(immovable, body.inv_inertia.x) = V(0);
+    body.inv_inertia.x = select(immovable, V(0), body.inv_inertia.x);
   }
 }
 
@@ -214,16 +227,17 @@ COLLIDE_LANE_INLINE SlidingDirection<V> sliding_direction(const Vec3<V>& ut) {
   const V unscale = select(tiny, V(S::kDown), select(huge, V(S::kUp), V(1)));
   SlidingDirection<V> d;
   d.unit = ut * scale;
-  d.scaled_length = stdx::sqrt(dot(d.unit, d.unit));
+  d.scaled_length = lane_sqrt(dot(d.unit, d.unit));
   d.speed = d.scaled_length * unscale;
   return d;
 }
 
-/// The law for W contacts whose bodies are pairwise distinct (or immovable).
-/// kFriction selects the Coulomb step; without it `mu` is never read.
+/// The law for W contacts whose bodies are pairwise distinct (or immovable),
+/// evaluated in the lanes V. kFriction selects the Coulomb step; without it
+/// `mu` is never read.
 template <class M, class V, bool kFriction>
-COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
-                                                      const ContactLanes<V>& contact) {
+COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                  const ContactLanes<V>& contact) {
   zero_immovable_inertia(a);
   zero_immovable_inertia(b);
   const Vec3<V>& n = contact.n;
@@ -260,12 +274,109 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
       const LeverArm<V> tarm_a = lever_arm(a, ra, t);
       const LeverArm<V> tarm_b = lever_arm(b, rb, t);
       const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
-      const V jt = select(sliding, stdx::min(slide.speed / k_t, contact.mu * jn), V(0));
+      const V jt = select(sliding, lane_min(slide.speed / k_t, contact.mu * jn), V(0));
       apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
       result.j = select(sliding, result.j - t * jt, result.j);
     }
   }
   return result;
+}
+
+template <class V>
+COLLIDE_LANE_INLINE Vec3<typename AccurateLanes<V>::type> widen(const Vec3<V>& v) {
+  using A = AccurateLanes<V>;
+  return {A::widen(v.x), A::widen(v.y), A::widen(v.z)};
+}
+template <class V, class W>
+COLLIDE_LANE_INLINE Vec3<V> narrow(const Vec3<W>& w) {
+  using A = AccurateLanes<V>;
+  return {A::narrow(w.x), A::narrow(w.y), A::narrow(w.z)};
+}
+
+/// The rotation of q / |q|, as the law defines it: q is normalised here
+/// (s = 2 / |q|^2), where the fast mode trusts the stored q to be unit.
+template <class W>
+COLLIDE_LANE_INLINE Mat3<W> normalised_rotation(const QuatLanes<W>& q) {
+  const W one(1);
+  const W xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
+  const W xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
+  const W wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
+  const W s = W(2) / (((q.w * q.w + xx) + yy) + zz);
+  Mat3<W> m;
+  m.r[0][0] = one - s * (yy + zz);
+  m.r[0][1] = s * (xy - wz);
+  m.r[0][2] = s * (xz + wy);
+  m.r[1][0] = s * (xy + wz);
+  m.r[1][1] = one - s * (xx + zz);
+  m.r[1][2] = s * (yz - wx);
+  m.r[2][0] = s * (xz - wy);
+  m.r[2][1] = s * (yz + wx);
+  m.r[2][2] = one - s * (xx + yy);
+  return m;
+}
+
+/// One side's bodies in the accurate mode's lanes (exact: widening).
+template <class M, class V>
+COLLIDE_LANE_INLINE BodyLanes<M, typename AccurateLanes<V>::type> widen_body(const BodyLanes<M, V>& b) {
+  using A = AccurateLanes<V>;
+  BodyLanes<M, typename A::type> w;
+  w.inv_mass = A::widen(b.inv_mass);
+  w.v = widen(b.v);
+  if constexpr (kRotates<M>) {
+    w.p = widen(b.p);
+    w.w = widen(b.w);
+  }
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    w.inv_inertia = widen(b.inv_inertia);
+    w.rotation = normalised_rotation(
+        QuatLanes<typename A::type>{A::widen(b.q.w), A::widen(b.q.x), A::widen(b.q.y), A::widen(b.q.z)});
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    w.inv_inertia.x = A::widen(b.inv_inertia.x);
+  }
+  return w;
+}
+
+/// The law in the accurate mode: the same body (evaluate_law) run on the
+/// wider lanes of exact_lanes.hpp - double lanes for float, double-double
+/// for double - from the stored inputs with q and n normalised as the law
+/// says, and every result rounded once to the stored precision. Every
+/// cancellation the fast mode suffers (u and vn, the lever arms r x n and
+/// R^T (r x n), friction's u' and ut) happens in the wider lanes, so J is
+/// within about one rounding of the exact law (docs/collision-law.md,
+/// "Accuracy modes"). Inactive lanes keep their bits: widening is exact and
+/// narrowing a widened value returns it.
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> evaluate_law_accurately(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                             const ContactLanes<V>& contact) {
+  using A = AccurateLanes<V>;
+  using W = typename A::type;
+  BodyLanes<M, W> wa = widen_body(a);
+  BodyLanes<M, W> wb = widen_body(b);
+  ContactLanes<W> wc;
+  if constexpr (kRotates<M>) wc.c = widen(contact.c);
+  const Vec3<W> n = widen(contact.n);
+  wc.n = n * (W(1) / lane_sqrt(dot(n, n)));
+  wc.e = A::widen(contact.e);
+  if constexpr (kFriction) wc.mu = A::widen(contact.mu);
+  const ContactResult<W> r = evaluate_law<M, W, kFriction>(wa, wb, wc);
+  a.v = narrow<V>(wa.v);
+  b.v = narrow<V>(wb.v);
+  if constexpr (kRotates<M>) {
+    a.w = narrow<V>(wa.w);
+    b.w = narrow<V>(wb.w);
+  }
+  return ContactResult<V>{narrow<V>(r.j)};
+}
+
+/// The law for W contacts in the mode `Mode` (FastMode or AccurateMode).
+template <class M, class V, bool kFriction, class Mode = FastMode>
+COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                      const ContactLanes<V>& contact) {
+  if constexpr (std::is_same_v<Mode, AccurateMode>) {
+    return evaluate_law_accurately<M, V, kFriction>(a, b, contact);
+  } else {
+    return evaluate_law<M, V, kFriction>(a, b, contact);
+  }
 }
 
 }  // namespace COLLIDE_KERNEL_NS

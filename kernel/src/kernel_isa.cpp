@@ -51,12 +51,6 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
-/// The quaternion lanes of a rigid body, turned into its rotation once read.
-template <class V>
-struct QuatLanes {
-  V w, x, y, z;
-};
-
 /// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
 /// so that the index gather and the paired load share one field list.
 template <class M, class V, class View, class F>
@@ -66,14 +60,12 @@ COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyL
     f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
     f(view.inv_inertia.y, a.inv_inertia.y, b.inv_inertia.y);
     f(view.inv_inertia.z, a.inv_inertia.z, b.inv_inertia.z);
-    QuatLanes<V> qa;
-    QuatLanes<V> qb;
-    f(view.q.w, qa.w, qb.w);
-    f(view.q.x, qa.x, qb.x);
-    f(view.q.y, qa.y, qb.y);
-    f(view.q.z, qa.z, qb.z);
-    a.rotation = rotation(qa.w, qa.x, qa.y, qa.z);
-    b.rotation = rotation(qb.w, qb.x, qb.y, qb.z);
+    f(view.q.w, a.q.w, b.q.w);
+    f(view.q.x, a.q.x, b.q.x);
+    f(view.q.y, a.q.y, b.q.y);
+    f(view.q.z, a.q.z, b.q.z);
+    a.rotation = rotation(a.q.w, a.q.x, a.q.y, a.q.z);
+    b.rotation = rotation(b.q.w, b.q.x, b.q.y, b.q.z);
   } else if constexpr (std::is_same_v<M, SphereModel>) {
     f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
   }
@@ -125,7 +117,7 @@ template <class View>
 inline constexpr bool kSoaLayout = std::is_pointer_v<decltype(View::inv_mass)>;
 
 /// Resolves one group of V::size() contacts.
-template <class M, class V, bool kFriction, class T, class View, class Records>
+template <class M, class V, bool kFriction, class Mode, class T, class View, class Records>
 COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records, const ContactView<T>& contacts,
                                      const ImpulseView<T>& impulses, const ContactGroup& g) {
   constexpr std::size_t W = V::size();
@@ -173,7 +165,7 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
   c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
   if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
 
-  const ContactResult<V> r = resolve_contacts<M, V, kFriction>(a, b, c);
+  const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
 
   // An immovable body is never written, not even with its own value: another
   // thread may be reading it (the ground is in many contacts of a batch).
@@ -223,7 +215,7 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
 /// overlap instead of waiting one after another.
 inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
 
-template <class M, class V, bool kFriction, class T, class View, class Records>
+template <class M, class V, bool kFriction, class Mode, class T, class View, class Records>
 COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* records, const ContactView<T>& contacts,
                                              const ImpulseView<T>& impulses, const std::uint32_t* order,
                                              bool contiguous, std::size_t begin, std::size_t end) {
@@ -242,33 +234,34 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* 
           prefetch_record(records, contacts.a[order[k]]);
           prefetch_record(records, contacts.b[order[k]]);
         }
-        solve_group<M, V, kFriction, T>(bodies, records, contacts, impulses,
-                                        ContactGroup{contiguous, order[i], order + i});
+        solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
+                                              ContactGroup{contiguous, order[i], order + i});
       }
       return i;
     }
   }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, T>(bodies, records, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
+                                          ContactGroup{contiguous, order[i], order + i});
   }
   return i;
 }
 
 /// The job's model and friction, as template arguments.
-template <class V, class T>
-std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+template <class V, class T, class Mode>
+std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
   const auto run = [&](const auto& view, auto model, auto friction) {
     using M = decltype(model);
     constexpr bool kFriction = decltype(friction)::value;
-    return solve_groups<M, V, kFriction, T>(view, static_cast<const char*>(nullptr), job.contacts, job.impulses,
-                                            job.order, contiguous, begin, end);
+    return solve_groups<M, V, kFriction, Mode, T>(view, static_cast<const char*>(nullptr), job.contacts, job.impulses,
+                                                  job.order, contiguous, begin, end);
   };
   const auto run_packed = [&](const auto& packed, auto model, auto friction) {
     using M = decltype(model);
     constexpr bool kFriction = decltype(friction)::value;
     const PackedFields<std::remove_pointer_t<decltype(packed.bodies)>> fields(packed);
-    return solve_groups<M, V, kFriction, T>(fields, packed.bodies, job.contacts, job.impulses, job.order, contiguous,
-                                            begin, end);
+    return solve_groups<M, V, kFriction, Mode, T>(fields, packed.bodies, job.contacts, job.impulses, job.order,
+                                                  contiguous, begin, end);
   };
   const std::true_type with_friction;
   const std::false_type without;
@@ -296,6 +289,13 @@ std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size
       break;
   }
   return job.friction ? run(job.rigid, RigidModel{}, with_friction) : run(job.rigid, RigidModel{}, without);
+}
+
+/// ... and its accuracy mode.
+template <class V, class T>
+std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  return job.accurate ? solve_job_groups_in<V, T, AccurateMode>(job, contiguous, begin, end)
+                      : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
 }
 
 }  // namespace

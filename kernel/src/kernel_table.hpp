@@ -39,6 +39,7 @@ struct KernelJob {
   Model model = Model::rigid;
   bool friction = false;  ///< contacts.mu is set: run the Coulomb step
   bool packed = false;    ///< the bodies are in a packed_* member, not a SoA view
+  bool accurate = false;  ///< Accuracy::accurate: the law in wider lanes (exact_lanes.hpp)
   BodyView<T> rigid;
   SphereView<T> sphere;
   ParticleView<T> particle;

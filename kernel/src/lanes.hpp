@@ -190,6 +190,18 @@ COLLIDE_LANE_INLINE void store_interleaved(const V& even, const V& odd, typename
   }
 }
 
+/// sqrt and min of lanes. The kernel body calls these rather than stdx::sqrt
+/// and stdx::min, so that the accurate mode's double-double lanes
+/// (exact_lanes.hpp) can bring their own.
+template <class V>
+COLLIDE_LANE_INLINE V lane_sqrt(const V& x) {
+  return stdx::sqrt(x);
+}
+template <class V>
+COLLIDE_LANE_INLINE V lane_min(const V& a, const V& b) {
+  return stdx::min(a, b);
+}
+
 /// A 3-vector of lanes.
 template <class V>
 struct Vec3 {

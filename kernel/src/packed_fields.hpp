@@ -117,6 +117,7 @@ COLLIDE_LANE_INLINE void read_records(const Record* records, const Index* idx, B
     body.v = {x[0], x[1], x[2]};
     body.w = {x[3], x[4], x[5]};
     body.p = {x[6], x[7], x[8]};
+    body.q = {x[9], x[10], x[11], x[12]};
     body.rotation = rotation(x[9], x[10], x[11], x[12]);
     body.inv_mass = x[13];
     body.inv_inertia = {x[14], x[15], x[16]};

@@ -1,29 +1,120 @@
 // reference.cpp - the law of docs/collision-law.md, transcribed.
 //
-// World frame, Eigen 3x3 matrices, Iw^-1 = R diag(1/I) R^T (applied as its
-// three factors, see RefBody), contacts in input order. No lanes and no local-frame shortcut: this is the independent
-// statement that the local-frame kernel is checked against. It reads the same
-// stored inputs as the kernels (inverse mass, inverse moments, q, n), so that
-// a difference measures the kernel's arithmetic, not input rounding. q and n
-// are normalised here in S, as the law says: a double normal widened to long
-// double is unit only to double precision, and K(n) = 1/ma + 1/mb + ...
-// assumes |n| = 1 (without this the reference was only double-accurate).
+// World frame, 3x3 matrices, Iw^-1 = R diag(1/I) R^T (applied as its three
+// factors, see RefBody), contacts in input order. No lanes and no local-frame
+// shortcut: this is the independent statement that the local-frame kernel is
+// checked against. It reads the same stored inputs as the kernels (inverse
+// mass, inverse moments, q, n), so that a difference measures the kernel's
+// arithmetic, not input rounding. q and n are normalised here in S, as the
+// law says: a double normal widened to long double is unit only to double
+// precision, and K(n) = 1/ma + 1/mb + ... assumes |n| = 1 (without this the
+// reference was only double-accurate).
+//
+// Written over a plain 3-vector of S rather than Eigen, so that one
+// transcription serves double, long double (64-bit mantissa) and, where GCC
+// has it, __float128 (113 bits, libquadmath's sqrtq): long double is too
+// short to judge the accurate mode in double (a grazing contact amplifies its
+// 5e-20 rounding by 1e7, far above double's ulp), and Eigen has no numeric
+// traits for __float128. Every operation is a correctly rounded +, -, *, /
+// or sqrt in S.
 #include <algorithm>
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Dense>
-#include <Eigen/Geometry>
-
 #include "collide/reference.hpp"
+
+#if COLLIDE_HAS_FLOAT128
+#include <quadmath.h>
+#endif
 
 namespace collide {
 namespace {
 
 template <class S>
+S ref_sqrt(S x) {
+  return std::sqrt(x);
+}
+#if COLLIDE_HAS_FLOAT128
+template <>
+__float128 ref_sqrt(__float128 x) {
+  return sqrtq(x);
+}
+#endif
+
+template <class S>
+S ref_abs(S x) {
+  return x < S(0) ? -x : x;
+}
+
+/// A 3-vector of S with the few operations the law needs (Eigen's names).
+template <class S>
+struct Vec {
+  S v[3] = {S(0), S(0), S(0)};
+  Vec() = default;
+  Vec(S x, S y, S z) : v{x, y, z} {}
+  S x() const { return v[0]; }
+  S y() const { return v[1]; }
+  S z() const { return v[2]; }
+  static Vec Zero() { return {}; }
+  Vec operator+(const Vec& b) const { return {v[0] + b.v[0], v[1] + b.v[1], v[2] + b.v[2]}; }
+  Vec operator-(const Vec& b) const { return {v[0] - b.v[0], v[1] - b.v[1], v[2] - b.v[2]}; }
+  Vec operator*(S s) const { return {v[0] * s, v[1] * s, v[2] * s}; }
+  Vec operator/(S s) const { return {v[0] / s, v[1] / s, v[2] / s}; }
+  Vec& operator+=(const Vec& b) { return *this = *this + b; }
+  Vec& operator-=(const Vec& b) { return *this = *this - b; }
+  friend Vec operator*(S s, const Vec& a) { return a * s; }
+  S dot(const Vec& b) const { return v[0] * b.v[0] + v[1] * b.v[1] + v[2] * b.v[2]; }
+  Vec cross(const Vec& b) const {
+    return {v[1] * b.v[2] - v[2] * b.v[1], v[2] * b.v[0] - v[0] * b.v[2], v[0] * b.v[1] - v[1] * b.v[0]};
+  }
+  Vec cwiseProduct(const Vec& b) const { return {v[0] * b.v[0], v[1] * b.v[1], v[2] * b.v[2]}; }
+  Vec cwiseAbs() const { return {ref_abs(v[0]), ref_abs(v[1]), ref_abs(v[2])}; }
+  S squaredNorm() const { return dot(*this); }
+  S norm() const { return ref_sqrt(squaredNorm()); }
+  Vec normalized() const { return *this / norm(); }
+  S maxCoeff() const { return std::max({v[0], v[1], v[2]}); }
+};
+
+/// A rotation matrix of S, row-major.
+template <class S>
+struct Rot {
+  S m[3][3];
+  Vec<S> operator*(const Vec<S>& x) const {
+    return {m[0][0] * x.v[0] + m[0][1] * x.v[1] + m[0][2] * x.v[2],
+            m[1][0] * x.v[0] + m[1][1] * x.v[1] + m[1][2] * x.v[2],
+            m[2][0] * x.v[0] + m[2][1] * x.v[1] + m[2][2] * x.v[2]};
+  }
+  /// R^T x.
+  Vec<S> transposed_times(const Vec<S>& x) const {
+    return {m[0][0] * x.v[0] + m[1][0] * x.v[1] + m[2][0] * x.v[2],
+            m[0][1] * x.v[0] + m[1][1] * x.v[1] + m[2][1] * x.v[2],
+            m[0][2] * x.v[0] + m[1][2] * x.v[1] + m[2][2] * x.v[2]};
+  }
+  /// The rotation of the unit quaternion (w, x, y, z), as Eigen forms it.
+  static Rot of_unit_quaternion(S w, S x, S y, S z) {
+    const S tx = 2 * x, ty = 2 * y, tz = 2 * z;
+    const S twx = tx * w, twy = ty * w, twz = tz * w;
+    const S txx = tx * x, txy = ty * x, txz = tz * x;
+    const S tyy = ty * y, tyz = tz * y, tzz = tz * z;
+    Rot r;
+    r.m[0][0] = S(1) - (tyy + tzz);
+    r.m[0][1] = txy - twz;
+    r.m[0][2] = txz + twy;
+    r.m[1][0] = txy + twz;
+    r.m[1][1] = S(1) - (txx + tzz);
+    r.m[1][2] = tyz - twx;
+    r.m[2][0] = txz - twy;
+    r.m[2][1] = tyz + twx;
+    r.m[2][2] = S(1) - (txx + tyy);
+    return r;
+  }
+};
+
+template <class S>
 struct RefBody {
-  using V3 = Eigen::Matrix<S, 3, 1>;
-  using M3 = Eigen::Matrix<S, 3, 3>;
+  using V3 = Vec<S>;
+  using M3 = Rot<S>;
+
   S inv_mass;
   S inv_inertia_max;  // the largest eigenvalue of Iw^-1 (0 for an immovable body)
   M3 rotation;        // R, body to world
@@ -35,7 +126,7 @@ struct RefBody {
   /// rounding of the large one: with a moment ratio of 1e-12 (a needle) the
   /// formed matrix was off by ~1e-7 relative even in long double, and the
   /// reference, not the kernel, was wrong.
-  V3 inv_inertia_world(const V3& x) const { return rotation * inv_inertia.cwiseProduct(rotation.transpose() * x); }
+  V3 inv_inertia_world(const V3& x) const { return rotation * inv_inertia.cwiseProduct(rotation.transposed_times(x)); }
 
   RefBody(const BodyView<S>& bodies, std::size_t i) {
     inv_mass = bodies.inv_mass[i];
@@ -43,9 +134,9 @@ struct RefBody {
     const bool immovable = inv_mass == S(0);
     const V3 inv_i =
         immovable ? V3::Zero() : V3(bodies.inv_inertia.x[i], bodies.inv_inertia.y[i], bodies.inv_inertia.z[i]);
-    const Eigen::Quaternion<S> q =
-        Eigen::Quaternion<S>(bodies.q.w[i], bodies.q.x[i], bodies.q.y[i], bodies.q.z[i]).normalized();
-    rotation = q.toRotationMatrix();
+    const S qw = bodies.q.w[i], qx = bodies.q.x[i], qy = bodies.q.y[i], qz = bodies.q.z[i];
+    const S qn = ref_sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+    rotation = M3::of_unit_quaternion(qw / qn, qx / qn, qy / qn, qz / qn);
     inv_inertia = inv_i;
     inv_inertia_max = inv_i.maxCoeff();
     p = V3(bodies.p.x[i], bodies.p.y[i], bodies.p.z[i]);
@@ -69,7 +160,7 @@ struct RefBody {
 template <class S>
 void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
                      ReferenceContact<S>* diagnostics) {
-  using V3 = Eigen::Matrix<S, 3, 1>;
+  using V3 = Vec<S>;
   // The uncertainty each body's velocities inherit from the contacts applied
   // to it before (linear [m/s] and angular [rad/s], in units of C eps): a
   // kernel's impulse on a contact is off by up to C eps s (s its impulse
@@ -112,7 +203,7 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     // along r (|h| << |r|) that is many times eps K(d).
     auto lever_sensitivity = [&](const V3& d) {
       auto body = [&](const RefBody<S>& x, const V3& r) {
-        const V3 h = x.rotation.transpose() * r.cross(d);
+        const V3 h = x.rotation.transposed_times(r.cross(d));
         return r.norm() * x.inv_inertia.dot(h.cwiseAbs());
       };
       return S(2) * (body(a, ra) + body(b, rb));
@@ -139,7 +230,7 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     // or not: a kernel that rounds a near-zero vn to the other side owes an
     // error measured against it.
     if (d.k_n != S(0)) {
-      d.impulse_scale = (S(1) + e) * (d.speed_scale + std::abs(d.vn) * lever_sensitivity(n) / d.k_n) / d.k_n;
+      d.impulse_scale = (S(1) + e) * (d.speed_scale + ref_abs(d.vn) * lever_sensitivity(n) / d.k_n) / d.k_n;
     }
     if (d.vn < S(0) && d.k_n != S(0)) {
       d.jn = -(S(1) + e) * d.vn / d.k_n;
@@ -189,5 +280,9 @@ template void reference_solve<double>(const BodyView<double>&, const ContactView
                                       ReferenceContact<double>*);
 template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
                                            const ImpulseView<long double>&, ReferenceContact<long double>*);
+#if COLLIDE_HAS_FLOAT128
+template void reference_solve<__float128>(const BodyView<__float128>&, const ContactView<__float128>&,
+                                          const ImpulseView<__float128>&, ReferenceContact<__float128>*);
+#endif
 
 }  // namespace collide

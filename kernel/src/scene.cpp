@@ -5,23 +5,58 @@
 // at the boundary, so that the kernels never divide by a mass.
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/reference.hpp"  // COLLIDE_HAS_FLOAT128
+
+#if COLLIDE_HAS_FLOAT128
+#include <quadmath.h>
+#endif
 
 namespace collide {
 namespace {
 
+// sqrt, isinf and inf for every T a buffer holds (__float128 has no
+// std:: overloads, and numeric_limits knows it only in GNU mode).
+template <class T>
+T scene_sqrt(T x) {
+#if COLLIDE_HAS_FLOAT128
+  if constexpr (std::is_same_v<T, __float128>) {
+    return sqrtq(x);
+  } else
+#endif
+  {
+    return std::sqrt(x);
+  }
+}
+template <class T>
+bool is_infinite(T x) {
+  return x == x && !(x - x == x - x);
+}
+template <class T>
+T infinity() {
+#if COLLIDE_HAS_FLOAT128
+  if constexpr (std::is_same_v<T, __float128>) {
+    return HUGE_VALQ;
+  } else
+#endif
+  {
+    return std::numeric_limits<T>::infinity();
+  }
+}
+
 // 1/x with 1/inf = 0 (an immovable body or a locked axis).
 template <class T>
 T inverse_or_zero(T x) {
-  return std::isinf(x) ? T(0) : T(1) / x;
+  return is_infinite(x) ? T(0) : T(1) / x;
 }
 
 // 1/x with 1/0 = inf, the inverse of inverse_or_zero.
 template <class T>
 T inverse_or_inf(T x) {
-  return x == T(0) ? std::numeric_limits<T>::infinity() : T(1) / x;
+  return x == T(0) ? infinity<T>() : T(1) / x;
 }
 
 }  // namespace
@@ -58,7 +93,8 @@ void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
   ix_[i] = immovable ? T(0) : inverse_or_zero(body.I[0]);
   iy_[i] = immovable ? T(0) : inverse_or_zero(body.I[1]);
   iz_[i] = immovable ? T(0) : inverse_or_zero(body.I[2]);
-  const T qn = std::sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
+  const T qn =
+      scene_sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
   qw_[i] = body.q[0] / qn;
   qx_[i] = body.q[1] / qn;
   qy_[i] = body.q[2] / qn;
@@ -151,7 +187,7 @@ void ContactBuffer<T>::set(std::size_t i, const ContactRecord<T>& contact) {
   cx_[i] = contact.c[0];
   cy_[i] = contact.c[1];
   cz_[i] = contact.c[2];
-  const T nn = std::sqrt(contact.n[0] * contact.n[0] + contact.n[1] * contact.n[1] + contact.n[2] * contact.n[2]);
+  const T nn = scene_sqrt(contact.n[0] * contact.n[0] + contact.n[1] * contact.n[1] + contact.n[2] * contact.n[2]);
   nx_[i] = contact.n[0] / nn;
   ny_[i] = contact.n[1] / nn;
   nz_[i] = contact.n[2] / nn;
@@ -202,5 +238,10 @@ template class BodyBuffer<long double>;
 template class ContactBuffer<float>;
 template class ContactBuffer<double>;
 template class ContactBuffer<long double>;
+#if COLLIDE_HAS_FLOAT128
+// The buffers of the __float128 reference (collide/reference.hpp).
+template class BodyBuffer<__float128>;
+template class ContactBuffer<__float128>;
+#endif
 
 }  // namespace collide

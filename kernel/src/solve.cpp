@@ -98,17 +98,8 @@ struct Solver::Impl {
       : options(o), kernels(&detail::kernel_table(resolve_isa(o.isa))), arena(&borrowed) {}
 };
 
-namespace {
-void check_options(const SolverOptions& options) {
-  if (options.accuracy == Accuracy::accurate) {
-    throw std::invalid_argument("collide::Solver: accuracy=accurate is not available yet");
-  }
-}
-}  // namespace
-
 Solver::Solver(const SolverOptions& options) {
   if (options.threads < 0) throw std::invalid_argument("collide::Solver: threads must be >= 0");
-  check_options(options);
   impl_ = std::make_unique<Impl>(options);
   impl_->arena->initialize();
 }
@@ -116,7 +107,6 @@ Solver::Solver(const ExternalArena& arena, const SolverOptions& options) {
   if (options.threads != 0) {
     throw std::invalid_argument("collide::Solver: threads must be 0 in a caller's arena (the arena decides)");
   }
-  check_options(options);
   impl_ = std::make_unique<Impl>(options, arena.arena);
   impl_->arena->initialize();  // no-op for an arena the caller already initialised
 }
@@ -222,10 +212,11 @@ SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb:
 }
 
 template <class T>
-KernelJob<T> make_job(Model model, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+KernelJob<T> make_job(Model model, Accuracy accuracy, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                       const Schedule& schedule) {
   KernelJob<T> job;
   job.model = model;
+  job.accurate = accuracy == Accuracy::accurate;
   job.friction = contacts.mu != nullptr;
   job.contacts = contacts;
   job.impulses = impulses;
@@ -293,7 +284,7 @@ void set_packed(KernelJob<T>& job, const PackedView<PackedParticle<T>>& v) {
 template <class Record, class View, class T>
 SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<T>& contacts,
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
-  detail::KernelJob<T> job = detail::make_job(model, contacts, impulses, schedule);
+  detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   if (!detail::should_pack(impl_->options.layout, schedule, bodies.count)) {
     if constexpr (std::is_same_v<View, BodyView<T>>) {
       job.rigid = bodies;
@@ -337,7 +328,7 @@ SolveStats Solver::run_packed(detail::KernelJob<T> job, std::size_t body_count, 
 template <class Record, class T>
 SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                                 const ImpulseView<T>& impulses, const Schedule& schedule) const {
-  detail::KernelJob<T> job = detail::make_job(model, contacts, impulses, schedule);
+  detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);

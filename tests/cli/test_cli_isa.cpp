@@ -1,7 +1,7 @@
 // test_cli_isa.cpp - `collide solve --isa` and COLLIDE_ISA through the real
 // CLI (issue 12): every ISA this CPU has writes the same bytes and says which
 // ran in --stats; an unknown or unsupported ISA is a usage error that writes
-// nothing.
+// nothing. The same holds for --accuracy accurate (issue 13), on every ISA.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -108,6 +108,37 @@ TEST_F(CliIsaTest, UnknownOrUnsupportedIsaIsAUsageErrorAndWritesNothing) {
     EXPECT_NE(u.err.find("not supported"), std::string::npos) << u.err;
     EXPECT_FALSE(fs::exists(dir_ / "ob-unsupported.csv"));
   }
+}
+
+// The accurate mode (issue 13) runs on the same dispatch: the same bytes on
+// every ISA, path and thread count, its name in --stats, and its bytes differ
+// from the fast mode's somewhere (it is not silently the fast mode).
+TEST_F(CliIsaTest, AccurateModeWritesTheSameBytesOnEveryIsaPathAndThreadCount) {
+  generate();
+  for (const char* precision : {"float", "double"}) {
+    SCOPED_TRACE(precision);
+    const RunResult fast = solve("fast", {"--precision", precision});
+    ASSERT_EQ(fast.exit_code, 0) << fast.err;
+    EXPECT_NE(fast.err.find("\"accuracy\": \"fast\""), std::string::npos) << fast.err;
+    const RunResult base =
+        solve("acc-scalar", {"--path", "scalar", "--precision", precision, "--accuracy", "accurate"});
+    ASSERT_EQ(base.exit_code, 0) << base.err;
+    EXPECT_NE(base.err.find("\"accuracy\": \"accurate\""), std::string::npos) << base.err;
+    EXPECT_NE(slurp(dir_ / "oj-acc-scalar.csv"), slurp(dir_ / "oj-fast.csv"));
+    for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+      if (!collide::isa_supported(isa)) continue;
+      const std::string name = std::string("acc-") + collide::to_string(isa);
+      const RunResult r = solve(name, {"--isa", collide::to_string(isa), "--precision", precision, "--threads", "2",
+                                       "--accuracy", "accurate", "--check"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_EQ(slurp(dir_ / ("ob-" + name + ".csv")), slurp(dir_ / "ob-acc-scalar.csv")) << name;
+      EXPECT_EQ(slurp(dir_ / ("oj-" + name + ".csv")), slurp(dir_ / "oj-acc-scalar.csv")) << name;
+    }
+  }
+  const RunResult bad = solve("acc-bad", {"--accuracy", "exact"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--accuracy"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "ob-acc-bad.csv"));
 }
 
 }  // namespace

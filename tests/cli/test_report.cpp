@@ -4,9 +4,10 @@
 // of this file (it takes seconds, and every test reads the same outputs):
 //   * the JSON holds every variant: both scenes, friction off and on, the
 //     reference in long double and double, the textbook loop in float and
-//     double, and every kernel row (scalar and SIMD, float and double, every
-//     model, every thread count), plus the Bullet row when the report says
-//     it was built with Bullet;
+//     double, and every kernel row (scalar, SIMD and accurate, float and
+//     double, every model, every thread count), plus the Bullet row when the
+//     report says it was built with Bullet;
+//   * the accurate rows of the float pairs are within 8 ulps of the law;
 //   * every row has the required fields with sane values: positive speed and
 //     bandwidth fraction, kernel errors within the documented bound,
 //     p99 <= max, the reference's own error 0, scalar and SIMD errors
@@ -224,7 +225,10 @@ Key key_of(const Json& row) {
           row.at("isa").str};
 }
 
-bool is_kernel(const Json& row) { return row.at("variant").str == "scalar" || row.at("variant").str == "simd"; }
+bool is_kernel(const Json& row) {
+  const std::string& v = row.at("variant").str;
+  return v == "scalar" || v == "simd" || v == "accurate";
+}
 
 TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
   ASSERT_EQ(result_->exit_code, 0) << result_->err;
@@ -289,6 +293,9 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
             expected.insert({scene, friction, "scalar", precision, model, threads, "sse2"});
             expected.insert(
                 {scene, friction, "simd", precision, model, threads, collide::to_string(collide::default_isa())});
+            // ... in the fast and (issue 13) the accurate mode.
+            expected.insert(
+                {scene, friction, "accurate", precision, model, threads, collide::to_string(collide::default_isa())});
           }
           // ... and every other ISA this CPU has, on the first thread count.
           for (const collide::Isa isa : {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512}) {
@@ -318,7 +325,7 @@ TEST_F(ReportRun, ValuesAreSane) {
                  row.at("model").str + " t" + std::to_string(static_cast<int>(row.at("threads").num)) +
                  (row.at("friction").b ? " friction" : ""));
     EXPECT_EQ(row.at("n").num, 20000);
-    EXPECT_EQ(row.at("simd").b, row.at("variant").str == "simd");
+    EXPECT_EQ(row.at("simd").b, row.at("variant").str == "simd" || row.at("variant").str == "accurate");
     ASSERT_EQ(row.at("collisions_per_second").kind, Json::number);
     EXPECT_GT(row.at("collisions_per_second").num, 0);
     ASSERT_EQ(row.at("bandwidth_fraction").kind, Json::number);
@@ -353,7 +360,7 @@ TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
   // The paths and thread counts agree bit for bit, so their errors do too.
   std::map<std::tuple<std::string, bool, std::string, std::string>, double> first;
   for (const Json& row : rows()) {
-    if (!is_kernel(row)) continue;
+    if (!is_kernel(row) || row.at("variant").str == "accurate") continue;
     const auto k =
         std::make_tuple(row.at("scene").str, row.at("friction").b, row.at("precision").str, row.at("model").str);
     const auto [it, inserted] = first.emplace(k, row.at("max_err_eps").num);
@@ -362,6 +369,23 @@ TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
           << std::get<0>(k) << " " << std::get<2>(k) << " " << std::get<3>(k) << " " << row.at("variant").str;
     }
   }
+}
+
+TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
+  ASSERT_TRUE(json_->has("rows"));
+  // The accurate variant (issue 13) on independent pairs: J within 8 ulps
+  // of the long double reference, which judges float exactly enough; and
+  // never less accurate than the fast SIMD row of the same scene.
+  std::size_t checked = 0;
+  for (const Json& row : rows()) {
+    if (row.at("variant").str != "accurate" || row.at("scene").str != "pairs" || row.at("precision").str != "float") {
+      continue;
+    }
+    SCOPED_TRACE(row.at("model").str + (row.at("friction").b ? " friction" : ""));
+    EXPECT_LE(row.at("max_rel_err").num, 8 * 1.1920929e-7);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2U * 3U * 2U);  // friction x models x threads
 }
 
 TEST_F(ReportRun, WritesThePng) {

@@ -1,11 +1,12 @@
 // collide/reference.hpp - the collision law, written as the spec writes it.
 //
 // This is the yardstick for every fast path: the law of docs/collision-law.md
-// evaluated in the world frame with Eigen matrices (Iw^-1 = R diag(1/I) R^T),
+// evaluated in the world frame with plain 3x3 matrices (Iw^-1 = R diag(1/I) R^T),
 // one contact after another in input order, in a scalar type S. It is
-// instantiated for double and for long double (x87 extended, 64-bit
-// mantissa), the high-precision reference against which float and double
-// kernels are measured. It is deliberately plain: no lanes, no schedule, no
+// instantiated for double, for long double (x87 extended, 64-bit mantissa),
+// the reference against which the fast kernels are measured, and for
+// __float128 where GCC has it (COLLIDE_HAS_FLOAT128), the one that judges
+// the accurate mode in double. It is deliberately plain: no lanes, no schedule, no
 // shortcuts.
 #pragma once
 
@@ -13,6 +14,15 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+
+// __float128 (113-bit significand) exists with GCC on x86-64; the reference
+// is instantiated for it there (libquadmath's sqrtq), to judge the accurate
+// mode in double, which long double's 64-bit significand cannot.
+#if defined(__SIZEOF_FLOAT128__) && defined(__GNUC__) && !defined(__clang__)
+#define COLLIDE_HAS_FLOAT128 1
+#else
+#define COLLIDE_HAS_FLOAT128 0
+#endif
 
 namespace collide {
 
@@ -57,5 +67,9 @@ extern template void reference_solve<double>(const BodyView<double>&, const Cont
                                              const ImpulseView<double>&, ReferenceContact<double>*);
 extern template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
                                                   const ImpulseView<long double>&, ReferenceContact<long double>*);
+#if COLLIDE_HAS_FLOAT128
+extern template void reference_solve<__float128>(const BodyView<__float128>&, const ContactView<__float128>&,
+                                                 const ImpulseView<__float128>&, ReferenceContact<__float128>*);
+#endif
 
 }  // namespace collide

@@ -28,7 +28,7 @@ namespace collide {
 /// One measured variant.
 struct ReportRow {
   std::string scene;      ///< "pairs" or "debris"
-  std::string variant;    ///< "reference", "textbook", "scalar", "simd" or "bullet"
+  std::string variant;    ///< "reference", "textbook", "scalar", "simd", "accurate" or "bullet"
   std::string model;      ///< "particle", "sphere" or "rigid"
   std::string precision;  ///< "float", "double" or "long double"
   bool simd = false;      ///< the SIMD path (lanes > 1)
@@ -56,6 +56,10 @@ struct ReportRow {
   double energy_drift = 0;            ///< |E - Eref| / E (initial)
   std::string note;                   ///< how the row differs from the others, if it does
 };
+
+/// True for the rows of collide's own kernel: "scalar", "simd" and
+/// "accurate" (the SIMD path with SolverOptions::accuracy = accurate).
+bool is_kernel_variant(const std::string& variant);
 
 /// One point of the throughput-against-N sweep (pairs scene, SIMD, float).
 struct SweepPoint {

@@ -93,10 +93,19 @@ int variant_rank(const std::string& v) {
   if (v == "textbook") return 1;
   if (v == "bullet") return 2;
   if (v == "scalar") return 3;
-  return 4;  // simd
+  if (v == "simd") return 4;
+  return 5;  // accurate: the SIMD path in Accuracy::accurate
 }
 int model_rank(const std::string& m) { return m == "rigid" ? 0 : m == "sphere" ? 1 : 2; }
 int precision_rank(const std::string& p) { return p == "long double" ? 0 : p == "double" ? 1 : 2; }
+
+}  // namespace
+
+bool is_kernel_variant(const std::string& variant) {
+  return variant == "scalar" || variant == "simd" || variant == "accurate";
+}
+
+namespace {
 
 /// Short label of a row for the plot: "simd float rigid".
 std::string label(const ReportRow& r) {
@@ -109,7 +118,7 @@ std::string label(const ReportRow& r) {
 
 void sort_report_rows(Report& report) {
   auto key = [](const ReportRow& r) {
-    const bool kernel = r.variant == "scalar" || r.variant == "simd";
+    const bool kernel = is_kernel_variant(r.variant);
     return std::make_tuple(r.scene == "pairs" ? 0 : 1, r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant),
                            model_rank(r.model), precision_rank(r.precision), variant_rank(r.variant), r.isa, r.threads);
   };
@@ -347,12 +356,12 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
                                                                : *std::max_element(report.machine.triad_threads.begin(),
                                                                                    report.machine.triad_threads.end());
   constexpr double kZeroErrorAt = 1e-20;  // where the yardstick (error 0) is drawn on a log axis
-  const char* const families[] = {"reference", "textbook", "bullet", "scalar", "simd"};
+  const char* const families[] = {"reference", "textbook", "bullet", "scalar", "simd", "accurate"};
   std::map<std::string, std::string> data;
   double min_error = 1;
   for (const ReportRow& r : report.rows) {
     if (r.scene != "pairs" || r.friction) continue;
-    const bool kernel = r.variant == "scalar" || r.variant == "simd";
+    const bool kernel = is_kernel_variant(r.variant);
     if (kernel ? r.threads != max_threads : r.threads != 1) continue;
     double error = r.max_err_eps * r.eps;
     std::string text = label(r);
@@ -398,11 +407,9 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
   gp << "set ylabel 'collisions per second'\n";
   gp << "set xrange [" << format("%.1e", kZeroErrorAt / 10) << ":1e-3]\n";
   gp << "set autoscale y\n";
-  const std::map<std::string, std::string> colour = {{"reference", "#000000"},
-                                                     {"textbook", "#7f7f7f"},
-                                                     {"bullet", "#2ca02c"},
-                                                     {"scalar", "#1f77b4"},
-                                                     {"simd", "#d62728"}};
+  const std::map<std::string, std::string> colour = {{"reference", "#000000"}, {"textbook", "#7f7f7f"},
+                                                     {"bullet", "#2ca02c"},    {"scalar", "#1f77b4"},
+                                                     {"simd", "#d62728"},      {"accurate", "#9467bd"}};
   std::string plot1;
   for (const char* family : families) {
     if (data.count(family) == 0) continue;

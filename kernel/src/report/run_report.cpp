@@ -201,7 +201,8 @@ std::vector<double> time_runs(int runs, const Restore& restore, const Solve& sol
 using Config = ReportOptions;
 
 constexpr Model kModels[] = {Model::rigid, Model::sphere, Model::particle};
-constexpr Path kPaths[] = {Path::scalar, Path::simd};
+constexpr std::pair<Path, Accuracy> kKernelVariants[] = {
+    {Path::scalar, Accuracy::fast}, {Path::simd, Accuracy::fast}, {Path::simd, Accuracy::accurate}};
 
 class Runner {
  public:
@@ -281,13 +282,16 @@ class Runner {
     return rows;
   }
 
-  const Solver& solver(Path path, int threads, Isa isa = Isa::automatic) {
-    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa), threads}];
+  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy) {
+    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) +
+                               (accuracy == Accuracy::accurate ? 16 : 0),
+                           threads}];
     if (!slot) {
       SolverOptions options;
       options.path = path;
       options.threads = threads;
       options.isa = isa;
+      options.accuracy = accuracy;
       slot = std::make_unique<Solver>(options);
     }
     return *slot;
@@ -295,13 +299,19 @@ class Runner {
 
   /// The kernel rows of one scene: scalar and SIMD (the default ISA) at every
   /// thread count, and SIMD on every other ISA the CPU has at the first.
-  [[nodiscard]] std::vector<std::tuple<Path, int, Isa>> kernel_variants() const {
-    std::vector<std::tuple<Path, int, Isa>> v;
-    for (const Path path : kPaths) {
-      for (const int threads : config_.threads) v.emplace_back(path, threads, Isa::automatic);
+  /// The kernel rows of one scene: the scalar path, the SIMD path (the
+  /// default ISA) and the SIMD path in the accurate mode (issue 13, variant
+  /// "accurate") at every thread count, and SIMD on every other ISA the CPU
+  /// has at the first.
+  [[nodiscard]] std::vector<std::tuple<Path, int, Isa, Accuracy>> kernel_variants() const {
+    std::vector<std::tuple<Path, int, Isa, Accuracy>> v;
+    for (const auto& [path, accuracy] : kKernelVariants) {
+      for (const int threads : config_.threads) v.emplace_back(path, threads, Isa::automatic, accuracy);
     }
     for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
-      if (isa_supported(isa) && isa != default_isa()) v.emplace_back(Path::simd, config_.threads.front(), isa);
+      if (isa_supported(isa) && isa != default_isa()) {
+        v.emplace_back(Path::simd, config_.threads.front(), isa, Accuracy::fast);
+      }
     }
     return v;
   }
@@ -381,10 +391,11 @@ class Runner {
         }
       }
 
-      for (const auto& [path, threads, isa] : kernel_variants()) {
+      for (const auto& [path, threads, isa, accuracy] : kernel_variants()) {
         {
-          const Solver& s = solver(path, threads, isa);
-          ReportRow row = new_row(kind, to_string(path), model, precision_name<T>(), friction, threads, n);
+          const Solver& s = solver(path, threads, isa, accuracy);
+          ReportRow row = new_row(kind, accuracy == Accuracy::accurate ? "accurate" : to_string(path), model,
+                                  precision_name<T>(), friction, threads, n);
           row.simd = path == Path::simd;
           progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
           const BodyView<T> bodies = scene.bodies.view();
@@ -504,7 +515,7 @@ class Runner {
     const std::size_t largest = *std::max_element(config_.sweep_n.begin(), config_.sweep_n.end());
     progress_->show("sweep: generating " + std::to_string(largest) + " pairs");
     Scene<float> scene = make_scene<float>(SceneKind::pairs, largest, false, config_.seed);
-    const Solver& s = solver(Path::simd, threads);
+    const Solver& s = solver(Path::simd, threads, Accuracy::fast);
     ImpulseBuffer<float> impulses(largest);
     SavedVelocities<float> saved;
     Schedule schedule;
