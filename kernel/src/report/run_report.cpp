@@ -515,7 +515,7 @@ class Runner {
     const std::size_t largest = *std::max_element(config_.sweep_n.begin(), config_.sweep_n.end());
     progress_->show("sweep: generating " + std::to_string(largest) + " pairs");
     Scene<float> scene = make_scene<float>(SceneKind::pairs, largest, false, config_.seed);
-    const Solver& s = solver(Path::simd, threads, Accuracy::fast);
+    const Solver& s = solver(Path::simd, threads, Isa::automatic, Accuracy::fast);
     ImpulseBuffer<float> impulses(largest);
     SavedVelocities<float> saved;
     Schedule schedule;
