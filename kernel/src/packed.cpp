@@ -35,6 +35,29 @@ void for_bodies(std::size_t count, F&& f) {
   });
 }
 
+/// A 3-vector of arrays, element i, into a record's three values and back.
+template <class T, class U>
+void get3(T (&to)[3], const Vec3Array<U>& from, std::size_t i) {
+  to[0] = from.x[i], to[1] = from.y[i], to[2] = from.z[i];
+}
+template <class T>
+void put3(const Vec3Array<T>& to, const T (&from)[3], std::size_t i) {
+  to.x[i] = from[0], to.y[i] = from[1], to.z[i] = from[2];
+}
+
+/// v (and w where the record has it) of the movable bodies, back into SoA.
+template <class Record, class View>
+void unpack_velocities_of(const PackedView<Record>& from, const View& to) {
+  using T = typename PackedValue<Record>::type;
+  check_counts(from.count, to.count, "collide::unpack_velocities");
+  for_bodies(from.count, [&](std::size_t i) {
+    const Record& r = from.bodies[i];
+    if (r.inv_mass == T(0)) return;
+    put3(to.v, r.v, i);
+    if constexpr (!std::is_same_v<Record, PackedParticle<T>>) put3(to.w, r.w, i);
+  });
+}
+
 }  // namespace
 
 template <class U>
@@ -42,9 +65,7 @@ void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_cons
   check_counts(from.count, to.count, "collide::pack");
   for_bodies(from.count, [&](std::size_t i) {
     auto& r = to.bodies[i];
-    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
-    r.w[0] = from.w.x[i], r.w[1] = from.w.y[i], r.w[2] = from.w.z[i];
-    r.p[0] = from.p.x[i], r.p[1] = from.p.y[i], r.p[2] = from.p.z[i];
+    get3(r.v, from.v, i), get3(r.w, from.w, i), get3(r.p, from.p, i);
     r.q[0] = from.q.w[i], r.q[1] = from.q.x[i], r.q[2] = from.q.y[i], r.q[3] = from.q.z[i];
     r.inv_mass = from.inv_mass[i];
     r.inv_inertia[0] = from.inv_inertia.x[i], r.inv_inertia[1] = from.inv_inertia.y[i];
@@ -57,9 +78,7 @@ void pack(const SphereView<U>& from, const PackedView<PackedSphere<std::remove_c
   check_counts(from.count, to.count, "collide::pack");
   for_bodies(from.count, [&](std::size_t i) {
     auto& r = to.bodies[i];
-    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
-    r.w[0] = from.w.x[i], r.w[1] = from.w.y[i], r.w[2] = from.w.z[i];
-    r.p[0] = from.p.x[i], r.p[1] = from.p.y[i], r.p[2] = from.p.z[i];
+    get3(r.v, from.v, i), get3(r.w, from.w, i), get3(r.p, from.p, i);
     r.inv_mass = from.inv_mass[i];
     r.inv_inertia = from.inv_inertia[i];
   });
@@ -70,7 +89,7 @@ void pack(const ParticleView<U>& from, const PackedView<PackedParticle<std::remo
   check_counts(from.count, to.count, "collide::pack");
   for_bodies(from.count, [&](std::size_t i) {
     auto& r = to.bodies[i];
-    r.v[0] = from.v.x[i], r.v[1] = from.v.y[i], r.v[2] = from.v.z[i];
+    get3(r.v, from.v, i);
     r.inv_mass = from.inv_mass[i];
   });
 }
@@ -80,9 +99,7 @@ void unpack(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
   check_counts(from.count, to.count, "collide::unpack");
   for_bodies(from.count, [&](std::size_t i) {
     const auto& r = from.bodies[i];
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
-    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
-    to.p.x[i] = r.p[0], to.p.y[i] = r.p[1], to.p.z[i] = r.p[2];
+    put3(to.v, r.v, i), put3(to.w, r.w, i), put3(to.p, r.p, i);
     to.q.w[i] = r.q[0], to.q.x[i] = r.q[1], to.q.y[i] = r.q[2], to.q.z[i] = r.q[3];
     to.inv_mass[i] = r.inv_mass;
     to.inv_inertia.x[i] = r.inv_inertia[0], to.inv_inertia.y[i] = r.inv_inertia[1];
@@ -95,9 +112,7 @@ void unpack(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
   check_counts(from.count, to.count, "collide::unpack");
   for_bodies(from.count, [&](std::size_t i) {
     const auto& r = from.bodies[i];
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
-    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
-    to.p.x[i] = r.p[0], to.p.y[i] = r.p[1], to.p.z[i] = r.p[2];
+    put3(to.v, r.v, i), put3(to.w, r.w, i), put3(to.p, r.p, i);
     to.inv_mass[i] = r.inv_mass;
     to.inv_inertia[i] = r.inv_inertia;
   });
@@ -108,41 +123,24 @@ void unpack(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to
   check_counts(from.count, to.count, "collide::unpack");
   for_bodies(from.count, [&](std::size_t i) {
     const auto& r = from.bodies[i];
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
+    put3(to.v, r.v, i);
     to.inv_mass[i] = r.inv_mass;
   });
 }
 
 template <class T>
 void unpack_velocities(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack_velocities");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    if (r.inv_mass == T(0)) return;
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
-    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
-  });
+  unpack_velocities_of(from, to);
 }
 
 template <class T>
 void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack_velocities");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    if (r.inv_mass == T(0)) return;
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
-    to.w.x[i] = r.w[0], to.w.y[i] = r.w[1], to.w.z[i] = r.w[2];
-  });
+  unpack_velocities_of(from, to);
 }
 
 template <class T>
 void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack_velocities");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    if (r.inv_mass == T(0)) return;
-    to.v.x[i] = r.v[0], to.v.y[i] = r.v[1], to.v.z[i] = r.v[2];
-  });
+  unpack_velocities_of(from, to);
 }
 
 #define COLLIDE_INSTANTIATE_PACK(U)                                                                     \
