@@ -121,6 +121,11 @@ if(COLLIDE_NEEDS_TBB)
     endif()
   endif()
   string(APPEND COLLIDE_PC_LIBS_PRIVATE "-ltbb")
+  # libquadmath: the __float128 reference's sqrtq (kernel/CMakeLists.txt);
+  # GCC's own runtime, in the linker's default path.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
+    string(APPEND COLLIDE_PC_LIBS_PRIVATE " -lquadmath")
+  endif()
 endif()
 configure_file(${CMAKE_CURRENT_LIST_DIR}/collide.pc.in ${PROJECT_BINARY_DIR}/package/collide.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/package/collide.pc DESTINATION ${COLLIDE_PC_DIR})
