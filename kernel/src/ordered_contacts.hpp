@@ -56,9 +56,7 @@ class OrderedContacts {
   }
 
   /// Where the kernel writes J in schedule order.
-  ImpulseView<T> impulses(std::size_t n) {
-    return {n, {j_[0].reserve(n), j_[1].reserve(n), j_[2].reserve(n)}};
-  }
+  ImpulseView<T> impulses(std::size_t n) { return {n, {j_[0].reserve(n), j_[1].reserve(n), j_[2].reserve(n)}}; }
 
   /// J back into input order: out[order[p]] = ordered[p].
   void scatter(const ImpulseView<T>& ordered, const ImpulseView<T>& out, const std::uint32_t* order) {

@@ -35,8 +35,8 @@
 #include <gtest/gtest.h>
 
 #include "collide/bandwidth.hpp"
-#include "collide/isa.hpp"
 #include "collide/error_bound.hpp"
+#include "collide/isa.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;

@@ -36,8 +36,8 @@
 #include "collide/contacts.hpp"
 #include "collide/solve.hpp"
 #include "lanes.hpp"
-#include "support/solve_helpers.hpp"
 #include "support/isa_test.hpp"
+#include "support/solve_helpers.hpp"
 
 namespace collide::test {
 namespace {

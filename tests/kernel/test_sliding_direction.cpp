@@ -22,8 +22,8 @@
 #include <gtest/gtest.h>
 
 #include "contact_kernel.hpp"
-#include "support/solve_helpers.hpp"
 #include "support/isa_test.hpp"
+#include "support/solve_helpers.hpp"
 
 namespace collide::test {
 namespace {

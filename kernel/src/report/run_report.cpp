@@ -283,9 +283,8 @@ class Runner {
   }
 
   const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy) {
-    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) +
-                               (accuracy == Accuracy::accurate ? 16 : 0),
-                           threads}];
+    auto& slot = solvers_[{
+        (path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) + (accuracy == Accuracy::accurate ? 16 : 0), threads}];
     if (!slot) {
       SolverOptions options;
       options.path = path;
