@@ -143,24 +143,29 @@ void unpack_velocities(const PackedView<PackedParticle<T>>& from, const Particle
   unpack_velocities_of(from, to);
 }
 
-#define COLLIDE_INSTANTIATE_PACK(U)                                                                     \
-  template void pack<U>(const BodyView<U>&, const PackedView<PackedRigid<std::remove_const_t<U>>>&);    \
-  template void pack<U>(const SphereView<U>&, const PackedView<PackedSphere<std::remove_const_t<U>>>&); \
-  template void pack<U>(const ParticleView<U>&, const PackedView<PackedParticle<std::remove_const_t<U>>>&);
-#define COLLIDE_INSTANTIATE_UNPACK(T)                                                           \
-  template void unpack<T>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);               \
-  template void unpack<T>(const PackedView<PackedSphere<T>>&, const SphereView<T>&);            \
-  template void unpack<T>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);        \
-  template void unpack_velocities<T>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);    \
-  template void unpack_velocities<T>(const PackedView<PackedSphere<T>>&, const SphereView<T>&); \
-  template void unpack_velocities<T>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);
-COLLIDE_INSTANTIATE_PACK(float)
-COLLIDE_INSTANTIATE_PACK(const float)
-COLLIDE_INSTANTIATE_PACK(double)
-COLLIDE_INSTANTIATE_PACK(const double)
-COLLIDE_INSTANTIATE_UNPACK(float)
-COLLIDE_INSTANTIATE_UNPACK(double)
-#undef COLLIDE_INSTANTIATE_PACK
-#undef COLLIDE_INSTANTIATE_UNPACK
+template void pack<float>(const BodyView<float>&, const PackedView<PackedRigid<float>>&);
+template void pack<float>(const SphereView<float>&, const PackedView<PackedSphere<float>>&);
+template void pack<float>(const ParticleView<float>&, const PackedView<PackedParticle<float>>&);
+template void pack<const float>(const BodyView<const float>&, const PackedView<PackedRigid<float>>&);
+template void pack<const float>(const SphereView<const float>&, const PackedView<PackedSphere<float>>&);
+template void pack<const float>(const ParticleView<const float>&, const PackedView<PackedParticle<float>>&);
+template void pack<double>(const BodyView<double>&, const PackedView<PackedRigid<double>>&);
+template void pack<double>(const SphereView<double>&, const PackedView<PackedSphere<double>>&);
+template void pack<double>(const ParticleView<double>&, const PackedView<PackedParticle<double>>&);
+template void pack<const double>(const BodyView<const double>&, const PackedView<PackedRigid<double>>&);
+template void pack<const double>(const SphereView<const double>&, const PackedView<PackedSphere<double>>&);
+template void pack<const double>(const ParticleView<const double>&, const PackedView<PackedParticle<double>>&);
+template void unpack<float>(const PackedView<PackedRigid<float>>&, const BodyView<float>&);
+template void unpack<float>(const PackedView<PackedSphere<float>>&, const SphereView<float>&);
+template void unpack<float>(const PackedView<PackedParticle<float>>&, const ParticleView<float>&);
+template void unpack_velocities<float>(const PackedView<PackedRigid<float>>&, const BodyView<float>&);
+template void unpack_velocities<float>(const PackedView<PackedSphere<float>>&, const SphereView<float>&);
+template void unpack_velocities<float>(const PackedView<PackedParticle<float>>&, const ParticleView<float>&);
+template void unpack<double>(const PackedView<PackedRigid<double>>&, const BodyView<double>&);
+template void unpack<double>(const PackedView<PackedSphere<double>>&, const SphereView<double>&);
+template void unpack<double>(const PackedView<PackedParticle<double>>&, const ParticleView<double>&);
+template void unpack_velocities<double>(const PackedView<PackedRigid<double>>&, const BodyView<double>&);
+template void unpack_velocities<double>(const PackedView<PackedSphere<double>>&, const SphereView<double>&);
+template void unpack_velocities<double>(const PackedView<PackedParticle<double>>&, const ParticleView<double>&);
 
 }  // namespace collide
