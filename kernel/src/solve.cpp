@@ -69,20 +69,23 @@ struct Solver::Impl {
     using T = typename PackedValue<Record>::type;
     constexpr bool f = std::is_same_v<T, float>;
     if constexpr (std::is_same_v<Record, PackedRigid<T>>) {
-      if constexpr (f)
+      if constexpr (f) {
         return rigid_f;
-      else
+      } else {
         return rigid_d;
+      }
     } else if constexpr (std::is_same_v<Record, PackedSphere<T>>) {
-      if constexpr (f)
+      if constexpr (f) {
         return sphere_f;
-      else
+      } else {
         return sphere_d;
+      }
     } else {
-      if constexpr (f)
+      if constexpr (f) {
         return particle_f;
-      else
+      } else {
         return particle_d;
+      }
     }
   }
 
@@ -428,6 +431,14 @@ Accuracy parse_accuracy(std::string_view name) {
   throw std::invalid_argument("unknown accuracy '" + std::string(name) + "' (expected fast or accurate)");
 }
 
+// The packed views, named so that the macro below takes T as a plain type.
+template <class T>
+using RigidRecords = PackedView<PackedRigid<T>>;
+template <class T>
+using SphereRecords = PackedView<PackedSphere<T>>;
+template <class T>
+using ParticleRecords = PackedView<PackedParticle<T>>;
+
 #define COLLIDE_INSTANTIATE(T)                                                                                  \
   template SolveStats Solver::solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
                                        const Schedule&) const;                                                  \
@@ -435,12 +446,12 @@ Accuracy parse_accuracy(std::string_view name) {
                                        const Schedule&) const;                                                  \
   template SolveStats Solver::solve<T>(const ParticleView<T>&, const ContactView<T>&, const ImpulseView<T>&,    \
                                        const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const PackedView<PackedRigid<T>>&, const ContactView<T>&,                \
-                                       const ImpulseView<T>&, const Schedule&) const;                           \
-  template SolveStats Solver::solve<T>(const PackedView<PackedSphere<T>>&, const ContactView<T>&,               \
-                                       const ImpulseView<T>&, const Schedule&) const;                           \
-  template SolveStats Solver::solve<T>(const PackedView<PackedParticle<T>>&, const ContactView<T>&,             \
-                                       const ImpulseView<T>&, const Schedule&) const;                           \
+  template SolveStats Solver::solve<T>(const RigidRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,    \
+                                       const Schedule&) const;                                                  \
+  template SolveStats Solver::solve<T>(const SphereRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,   \
+                                       const Schedule&) const;                                                  \
+  template SolveStats Solver::solve<T>(const ParticleRecords<T>&, const ContactView<T>&, const ImpulseView<T>&, \
+                                       const Schedule&) const;                                                  \
   template SolveStats Solver::solve<T>(Model, const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&, \
                                        const Schedule&) const;                                                  \
   template SolveStats solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,                \
