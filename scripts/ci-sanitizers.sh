@@ -2,7 +2,8 @@
 # CI, after the README's test command (.ci/run): the sanitized and fuzzed runs
 # of issue 6. Any finding fails the run (non-zero exit).
 #
-#   1. ASan + UBSan: one Clang build (Debug, so the kernels' asserts are on,
+#   1. ASan + UBSan: one Clang build (no Python module: a sanitized extension
+#      cannot load into an unsanitized interpreter; Debug, so the kernels' asserts are on,
 #      at -O1; see cmake/sanitizers.cmake) of the library, the CLI, every test
 #      and the fuzzers, then ctest. The `objects` test (test_isa_objects: it
 #      inspects the optimised objects the project ships) and the `package`
@@ -39,7 +40,7 @@ asan="$root/build-asan"
 stage "ASan+UBSan build"
 cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
   -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON \
-  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF >/dev/null
+  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$asan" -j"$jobs"
 stage "ASan+UBSan tests"
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
@@ -75,7 +76,7 @@ done
 tsan="$root/build-tsan"
 stage "TSan build"
 cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DCOLLIDE_SANITIZE=thread \
-  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF >/dev/null
+  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_solver_arena test_hard_shared \
   collide_itt_tsan collide_race_canary
 stage "TSan tests"

@@ -319,8 +319,10 @@ struct PySchedule {
 
 py::dict to_dict(const StatRecord& record) {
   py::dict d;
-  for (const auto& [key, value] : record) {
-    std::visit([&](const auto& x) { d[py::str(key)] = py::cast(x); }, value);
+  for (const auto& entry : record) {
+    // Not a structured binding: clang 14 cannot capture one in the lambda.
+    const std::string& key = entry.first;
+    std::visit([&](const auto& x) { d[py::str(key)] = py::cast(x); }, entry.second);
   }
   return d;
 }
