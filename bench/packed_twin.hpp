@@ -7,7 +7,7 @@
 // OrderedContacts pass), the batches run one after another with blocks of
 // 1024 contacts over TBB, each contact's two records are prefetched the same
 // distance ahead, every value of both records and of the contact is read,
-// v and w of both bodies and J are written (one add of a multiple of zero
+// v and w of the movable bodies and J are written (one add of a multiple of zero
 // per value instead of the law), and J goes back into input order. Kernel
 // throughput over twin throughput is the fraction of the layout's own
 // ceiling that the arithmetic leaves.

@@ -171,7 +171,6 @@ struct World {
   collide::PackedBuffer<Body> bodies;  // the state collide reads, and v, w it writes
   std::vector<Real> radius;            // [m]
   std::vector<double> mass, inertia;   // [kg], [kg m^2], for the energy
-  std::vector<Real> inv_mass;          // [1/kg], a copy of bodies[i].inv_mass for Schedule::build
   std::size_t spheres = 0;             // bodies 1..spheres are spheres, the rest particles
 
   [[nodiscard]] std::size_t size() const { return bodies.size(); }
@@ -187,7 +186,6 @@ struct World {
     radius.push_back(static_cast<Real>(r));
     mass.push_back(m);
     inertia.push_back(moment);
-    inv_mass.push_back(body.inv_mass);
   }
 
   /// The records as collide sees them; nothing is copied.
@@ -555,7 +553,7 @@ int main(int argc, char** argv) {
     // collide: one schedule for this step's contacts, several passes over it,
     // each writing v and w into the records in place.
     const auto s0 = std::chrono::steady_clock::now();
-    schedule.build(view, bodies.count, world.inv_mass.data());
+    schedule.build(view, bodies);  // inverse masses read from the records
     std::size_t resolved = 0;
     for (int pass = 0; pass < o.passes; ++pass) {
       stats = solver.solve(bodies, view, impulses, schedule);

@@ -24,7 +24,7 @@
 
 #include "contact_kernel.hpp"
 #include "kernel_table.hpp"
-#include "packed_fields.hpp"
+#include "record_lanes.hpp"
 
 #ifndef COLLIDE_PREFETCH_AHEAD
 #define COLLIDE_PREFETCH_AHEAD 32
@@ -111,15 +111,17 @@ COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* 
   return paired;
 }
 
-/// True for the SoA views (a field is a plain array), false for the packed
-/// layout's PackedFields (a field is strided).
+/// True for the SoA views (BodyView, SphereView, ParticleView: one array per
+/// component), false for a PackedView of records.
 template <class View>
-inline constexpr bool kSoaLayout = std::is_pointer_v<decltype(View::inv_mass)>;
+inline constexpr bool kSoaLayout = true;
+template <class Record>
+inline constexpr bool kSoaLayout<PackedView<Record>> = false;
 
 /// Resolves one group of V::size() contacts.
-template <class M, class V, bool kFriction, class Mode, class T, class View, class Records>
-COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records, const ContactView<T>& contacts,
-                                     const ImpulseView<T>& impulses, const ContactGroup& g) {
+template <class M, class V, bool kFriction, class Mode, class T, class View>
+COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                                     const ContactGroup& g) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
   BodyIndex ib[W];
@@ -152,9 +154,8 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
       });
     }
   } else {
-    (void)bodies;
-    read_records<M, V>(records, ia, a);
-    read_records<M, V>(records, ib, b);
+    read_records<M, V>(bodies.bodies, ia, a);
+    read_records<M, V>(bodies.bodies, ib, b);
   }
 
   ContactLanes<V> c;
@@ -190,8 +191,8 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
   } else {
     // a's records first, then b's: within a group no movable body repeats,
     // so the order of the stores cannot matter.
-    write_records<M, V>(const_cast<Records*>(records), ia, a, movable_a);
-    write_records<M, V>(const_cast<Records*>(records), ib, b, movable_b);
+    write_records<M, V>(bodies.bodies, ia, a, movable_a);
+    write_records<M, V>(bodies.bodies, ib, b, movable_b);
   }
   if (g.contiguous) {
     store(r.j.x, impulses.j.x + g.first);
@@ -215,8 +216,8 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const Records* records,
 /// overlap instead of waiting one after another.
 inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
 
-template <class M, class V, bool kFriction, class Mode, class T, class View, class Records>
-COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* records, const ContactView<T>& contacts,
+template <class M, class V, bool kFriction, class Mode, class T, class View>
+COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactView<T>& contacts,
                                              const ImpulseView<T>& impulses, const std::uint32_t* order,
                                              bool contiguous, std::size_t begin, std::size_t end) {
   constexpr std::size_t W = V::size();
@@ -225,24 +226,23 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* 
     if (W > 1) {
       const std::size_t warm = std::min(end, begin + kPrefetchAhead);
       for (std::size_t k = begin; k < warm; ++k) {
-        prefetch_record(records, contacts.a[order[k]]);
-        prefetch_record(records, contacts.b[order[k]]);
+        prefetch_record(bodies.bodies, contacts.a[order[k]]);
+        prefetch_record(bodies.bodies, contacts.b[order[k]]);
       }
       for (; i + W <= end; i += W) {
         const std::size_t ahead_end = std::min(end, i + W + kPrefetchAhead);
         for (std::size_t k = i + kPrefetchAhead; k < ahead_end; ++k) {
-          prefetch_record(records, contacts.a[order[k]]);
-          prefetch_record(records, contacts.b[order[k]]);
+          prefetch_record(bodies.bodies, contacts.a[order[k]]);
+          prefetch_record(bodies.bodies, contacts.b[order[k]]);
         }
-        solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
+        solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses,
                                               ContactGroup{contiguous, order[i], order + i});
       }
       return i;
     }
   }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, Mode, T>(bodies, records, contacts, impulses,
-                                          ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
   }
   return i;
 }
@@ -250,34 +250,27 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const Records* 
 /// The job's model and friction, as template arguments.
 template <class V, class T, class Mode>
 std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  // `view` is a SoA view or a PackedView: solve_group tells them apart.
   const auto run = [&](const auto& view, auto model, auto friction) {
     using M = decltype(model);
     constexpr bool kFriction = decltype(friction)::value;
-    return solve_groups<M, V, kFriction, Mode, T>(view, static_cast<const char*>(nullptr), job.contacts, job.impulses,
-                                                  job.order, contiguous, begin, end);
-  };
-  const auto run_packed = [&](const auto& packed, auto model, auto friction) {
-    using M = decltype(model);
-    constexpr bool kFriction = decltype(friction)::value;
-    const PackedFields<std::remove_pointer_t<decltype(packed.bodies)>> fields(packed);
-    return solve_groups<M, V, kFriction, Mode, T>(fields, packed.bodies, job.contacts, job.impulses, job.order,
-                                                  contiguous, begin, end);
+    return solve_groups<M, V, kFriction, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin, end);
   };
   const std::true_type with_friction;
   const std::false_type without;
   if (job.packed) {
     switch (job.model) {
       case Model::particle:
-        return job.friction ? run_packed(job.packed_particle, ParticleModel{}, with_friction)
-                            : run_packed(job.packed_particle, ParticleModel{}, without);
+        return job.friction ? run(job.packed_particle, ParticleModel{}, with_friction)
+                            : run(job.packed_particle, ParticleModel{}, without);
       case Model::sphere:
-        return job.friction ? run_packed(job.packed_sphere, SphereModel{}, with_friction)
-                            : run_packed(job.packed_sphere, SphereModel{}, without);
+        return job.friction ? run(job.packed_sphere, SphereModel{}, with_friction)
+                            : run(job.packed_sphere, SphereModel{}, without);
       case Model::rigid:
         break;
     }
-    return job.friction ? run_packed(job.packed_rigid, RigidModel{}, with_friction)
-                        : run_packed(job.packed_rigid, RigidModel{}, without);
+    return job.friction ? run(job.packed_rigid, RigidModel{}, with_friction)
+                        : run(job.packed_rigid, RigidModel{}, without);
   }
   switch (job.model) {
     case Model::particle:

@@ -107,10 +107,11 @@ void for_each_chunk(std::size_t items, std::size_t chunks, const F& f) {
 template <class Word>
 constexpr Word kImmovableWord = std::numeric_limits<Word>::max();
 
-/// Pass 1 for the bodies [begin, end).
+/// Pass 1 for the bodies [begin, end); body i's inverse mass is
+/// inv_mass[i * stride] (1 for SoA views, the record size for packed ones).
 template <class Word, class T>
-void fill_body_table(const T* inv_mass, std::size_t begin, std::size_t end, Word* next) {
-  for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i] != T(0) ? Word{0} : kImmovableWord<Word>;
+void fill_body_table(const T* inv_mass, std::size_t stride, std::size_t begin, std::size_t end, Word* next) {
+  for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i * stride] != T(0) ? Word{0} : kImmovableWord<Word>;
 }
 
 /// Pass 2 from contact k on: the level of each contact from the body table.
@@ -202,7 +203,8 @@ void widen(std::vector<std::uint32_t>& words, std::size_t count) {
 }  // namespace
 
 template <class T>
-void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, int threads) {
+void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass,
+                             std::size_t stride, int threads) {
   if (threads < 0) {
     throw std::invalid_argument("collide::Schedule::build: threads must be >= 0, got " + std::to_string(threads));
   }
@@ -229,7 +231,7 @@ void Schedule::build(const ContactView<T>& contacts, std::size_t body_count, con
   body_next_.resize((body_count + 3) / 4);
   level_.resize((n + 3) / 4);
   auto* const next8 = reinterpret_cast<std::uint8_t*>(body_next_.data());
-  fill_body_table(inv_mass, 0, body_count, next8);
+  fill_body_table(inv_mass, stride, 0, body_count, next8);
   std::uint32_t levels = 0;
   const std::size_t stop = assign_levels(contacts.a, contacts.b, 0, n, next8,
                                          reinterpret_cast<std::uint8_t*>(level_.data()), levels, conflicts_);
@@ -307,8 +309,9 @@ std::size_t Schedule::memory_bytes() const {
          contiguous_.capacity() * sizeof(std::uint8_t) + slot_.capacity() * sizeof(std::uint32_t);
 }
 
-template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*, int);
-template void Schedule::build<double>(const ContactView<double>&, std::size_t, const double*, int);
-template void Schedule::build<long double>(const ContactView<long double>&, std::size_t, const long double*, int);
+template void Schedule::build_strided<float>(const ContactView<float>&, std::size_t, const float*, std::size_t, int);
+template void Schedule::build_strided<double>(const ContactView<double>&, std::size_t, const double*, std::size_t, int);
+template void Schedule::build_strided<long double>(const ContactView<long double>&, std::size_t, const long double*,
+                                                   std::size_t, int);
 
 }  // namespace collide

@@ -394,9 +394,10 @@ Isa Solver::isa() const { return impl_->kernels->isa; }
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                  const SolverOptions& options) {
+  const Solver solver(options);  // validates the options before any work
   Schedule schedule;
-  schedule.build(contacts, bodies);
-  return Solver(options).solve(choose_model(bodies, contacts), bodies, contacts, impulses, schedule);
+  schedule.build(contacts, bodies, options.threads);  // on no more threads than the solve may use
+  return solver.solve(choose_model(bodies, contacts), bodies, contacts, impulses, schedule);
 }
 
 template <class T>

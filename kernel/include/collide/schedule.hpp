@@ -41,6 +41,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/packed.hpp"
 
 namespace collide {
 
@@ -59,7 +60,19 @@ class Schedule {
   }
   /// The same for any body model: only the inverse masses matter.
   template <class T>
-  void build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, int threads = 0);
+  void build(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, int threads = 0) {
+    build_strided(contacts, body_count, inv_mass, 1, threads);
+  }
+  /// The same on packed records (collide/packed.hpp): the inverse masses are
+  /// read in place from the records, so a caller who keeps its bodies packed
+  /// needs no other copy of them.
+  template <class Record>
+  void build(const ContactView<typename PackedValue<Record>::type>& contacts, const PackedView<Record>& bodies,
+             int threads = 0) {
+    using T = typename PackedValue<Record>::type;
+    const T* inv_mass = bodies.count != 0 ? &bodies.bodies->inv_mass : nullptr;
+    build_strided(contacts, bodies.count, inv_mass, sizeof(Record) / sizeof(T), threads);
+  }
 
   /// Number of contacts the schedule was built for.
   [[nodiscard]] std::size_t contact_count() const { return contact_count_; }
@@ -84,6 +97,11 @@ class Schedule {
   [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
+  /// build() with body i's inverse mass at inv_mass[i * stride].
+  template <class T>
+  void build_strided(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, std::size_t stride,
+                     int threads);
+
   std::size_t contact_count_ = 0;
   std::size_t body_count_ = 0;
   std::size_t largest_batch_ = 0;
