@@ -9,8 +9,6 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
 
-#include "ordered_contacts.hpp"
-
 namespace collide_bench {
 namespace {
 // A value the compiler cannot prove zero, so the adds are not folded away.
@@ -21,46 +19,61 @@ constexpr std::size_t kAhead = 32;  // contacts; as the kernel (COLLIDE_PREFETCH
 constexpr std::size_t kBlock = 1024;
 }  // namespace
 
-template <class T>
-void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<collide::PackedRigid<T>>& records,
-                      const collide::ContactView<T>& contacts, const collide::ImpulseView<T>& impulses,
+template <class Record>
+void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<Record>& records,
+                      const collide::ContactView<typename collide::PackedValue<Record>::type>& contacts,
+                      const collide::ImpulseView<typename collide::PackedValue<Record>::type>& impulses,
                       const collide::Schedule& schedule) {
-  static collide::detail::OrderedContacts<T> ordered;  // grown once, reused (the bench is one thread)
+  using T = typename collide::PackedValue<Record>::type;
+  // The values the kernel reads (v first, as every record starts) and writes.
+  constexpr std::size_t kValues = kRecordValues<Record>;
+  constexpr std::size_t kWritten = kWrittenValues<Record>;
   const T zero = static_cast<T>(g_packed_zero);
-  const std::size_t n = contacts.count;
-  collide::PackedRigid<T>* bodies = records.bodies;
+  const std::uint32_t* order = schedule.order();
+  const collide::ContactView<T>& c = contacts;
+  const collide::ImpulseView<T>& j = impulses;
+  Record* bodies = records.bodies;
   arena.execute([&] {
-    const collide::ContactView<T> c = ordered.gather(contacts, schedule.order());
-    const collide::ImpulseView<T> j = ordered.impulses(n);
-    auto prefetch = [&](std::size_t k) {
+    // As the kernel (kernel_isa.cpp, solve_groups): the records and the
+    // contact's own lines (its fields and J) are requested kAhead contacts
+    // ahead.
+    auto prefetch = [&](std::size_t p) {
+      const std::uint32_t k = order[p];
       for (const std::uint32_t i : {c.a[k], c.b[k]}) {
-        const char* p = reinterpret_cast<const char*>(bodies + i);
-        for (std::size_t off = 0; off < sizeof(collide::PackedRigid<T>); off += 64) __builtin_prefetch(p + off, 0, 2);
+        const char* r = reinterpret_cast<const char*>(bodies + i);
+        for (std::size_t off = 0; off < sizeof(Record); off += 64) __builtin_prefetch(r + off, 0, 2);
       }
+      for (const T* f : {c.c.x, c.c.y, c.c.z, c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
+      if (c.e != nullptr) __builtin_prefetch(c.e + k, 0, 2);
+      if (c.mu != nullptr) __builtin_prefetch(c.mu + k, 0, 2);
+      for (T* f : {j.j.x, j.j.y, j.j.z}) __builtin_prefetch(f + k, 1, 2);
     };
     auto run = [&](std::size_t begin, std::size_t end) {
       // One accumulator per record value: the loads feed short, independent
       // add chains, so the loop waits on memory and not on a chain of adds
       // (a single running sum made the twin slower than the kernel).
-      T acc[17] = {};
-      for (std::size_t k = begin; k < std::min(end, begin + kAhead); ++k) prefetch(k);
-      for (std::size_t k = begin; k < end; ++k) {
-        if (k + kAhead < end) prefetch(k + kAhead);
-        collide::PackedRigid<T>& a = bodies[c.a[k]];
-        collide::PackedRigid<T>& b = bodies[c.b[k]];
+      T acc[kValues] = {};
+      for (std::size_t p = begin; p < std::min(end, begin + kAhead); ++p) prefetch(p);
+      for (std::size_t p = begin; p < end; ++p) {
+        if (p + kAhead < end) prefetch(p + kAhead);
+        const std::uint32_t k = order[p];
+        Record& a = bodies[c.a[k]];
+        Record& b = bodies[c.b[k]];
         T sum = c.c.x[k] + c.c.y[k] + c.c.z[k] + c.n.x[k] + c.n.y[k] + c.n.z[k];
         if (c.e) sum += c.e[k];
         if (c.mu) sum += c.mu[k];
-        const T* va = a.v;  // the 17 values, v first
-        const T* vb = b.v;
-        for (std::size_t f = 0; f < 17; ++f) acc[f] += va[f] + vb[f];
+        // The record's values, v first (collide/packed.hpp: standard layout,
+        // the values contiguous from offset 0).
+        T* va = reinterpret_cast<T*>(&a);
+        T* vb = reinterpret_cast<T*>(&b);
+        for (std::size_t f = 0; f < kValues; ++f) acc[f] += va[f] + vb[f];
         // As the kernel: v and w of movable bodies only (the ground body is
         // in a quarter of the contacts and is never written).
         if (a.inv_mass != 0) {
-          for (std::size_t f = 0; f < 3; ++f) a.v[f] += zero * sum, a.w[f] += zero * sum;
+          for (std::size_t f = 0; f < kWritten; ++f) va[f] += zero * sum;
         }
         if (b.inv_mass != 0) {
-          for (std::size_t f = 0; f < 3; ++f) b.v[f] -= zero * sum, b.w[f] -= zero * sum;
+          for (std::size_t f = 0; f < kWritten; ++f) vb[f] -= zero * sum;
         }
         j.j.x[k] = zero * sum, j.j.y[k] = zero * sum, j.j.z[k] = zero * sum;
       }
@@ -81,16 +94,26 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
           },
           oneapi::tbb::simple_partitioner());
     }
-    ordered.scatter(j, impulses, schedule.order());
   });
 }
 
-template void packed_twin_pass<float>(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedRigid<float>>&,
-                                      const collide::ContactView<float>&, const collide::ImpulseView<float>&,
-                                      const collide::Schedule&);
-template void packed_twin_pass<double>(oneapi::tbb::task_arena&,
-                                       const collide::PackedView<collide::PackedRigid<double>>&,
-                                       const collide::ContactView<double>&, const collide::ImpulseView<double>&,
-                                       const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedRigid<float>>&,
+                               const collide::ContactView<float>&, const collide::ImpulseView<float>&,
+                               const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedRigid<double>>&,
+                               const collide::ContactView<double>&, const collide::ImpulseView<double>&,
+                               const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedSphere<float>>&,
+                               const collide::ContactView<float>&, const collide::ImpulseView<float>&,
+                               const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedSphere<double>>&,
+                               const collide::ContactView<double>&, const collide::ImpulseView<double>&,
+                               const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedParticle<float>>&,
+                               const collide::ContactView<float>&, const collide::ImpulseView<float>&,
+                               const collide::Schedule&);
+template void packed_twin_pass(oneapi::tbb::task_arena&, const collide::PackedView<collide::PackedParticle<double>>&,
+                               const collide::ContactView<double>&, const collide::ImpulseView<double>&,
+                               const collide::Schedule&);
 
 }  // namespace collide_bench

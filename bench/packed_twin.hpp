@@ -3,15 +3,16 @@
 // debris index pattern.
 //
 // It does what Solver::solve does on the caller's packed records, minus the
-// law: the contacts are copied into schedule order (the same
-// OrderedContacts pass), the batches run one after another with blocks of
-// 1024 contacts over TBB, each contact's two records are prefetched the same
-// distance ahead, every value of both records and of the contact is read,
-// v and w of the movable bodies and J are written (one add of a multiple of zero
-// per value instead of the law), and J goes back into input order. Kernel
-// throughput over twin throughput is the fraction of the layout's own
-// ceiling that the arithmetic leaves.
+// law: the batches run one after another with blocks of 1024 contacts over
+// TBB, each contact is read through the schedule's order with its two
+// records and its own lines prefetched the same distance ahead, every value
+// of both records and of the contact is read, v (and w) of the movable
+// bodies and J are written (one add of a multiple of zero per value instead
+// of the law). Kernel throughput over twin throughput is the fraction of the
+// layout's own ceiling that the arithmetic leaves.
 #pragma once
+
+#include <cstddef>
 
 #include <oneapi/tbb/task_arena.h>
 
@@ -21,11 +22,28 @@
 
 namespace collide_bench {
 
-/// One twin pass over rigid records in `arena`; `schedule` was built for the
-/// contacts. Values keep their bits unless an input is inf or NaN.
+/// Values of a record the kernel reads (all of them, from offset 0) and
+/// writes (v, and w where the model rotates): collide/packed.hpp.
+template <class Record>
+inline constexpr std::size_t kRecordValues = 0;
 template <class T>
-void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<collide::PackedRigid<T>>& records,
-                      const collide::ContactView<T>& contacts, const collide::ImpulseView<T>& impulses,
+inline constexpr std::size_t kRecordValues<collide::PackedRigid<T>> = 17;
+template <class T>
+inline constexpr std::size_t kRecordValues<collide::PackedSphere<T>> = 11;
+template <class T>
+inline constexpr std::size_t kRecordValues<collide::PackedParticle<T>> = 4;
+template <class Record>
+inline constexpr std::size_t kWrittenValues = 6;
+template <class T>
+inline constexpr std::size_t kWrittenValues<collide::PackedParticle<T>> = 3;
+
+/// One twin pass over the records (PackedRigid, PackedSphere or
+/// PackedParticle of float or double) in `arena`; `schedule` was built for
+/// the contacts. Values keep their bits unless an input is inf or NaN.
+template <class Record>
+void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<Record>& records,
+                      const collide::ContactView<typename collide::PackedValue<Record>::type>& contacts,
+                      const collide::ImpulseView<typename collide::PackedValue<Record>::type>& impulses,
                       const collide::Schedule& schedule);
 
 }  // namespace collide_bench

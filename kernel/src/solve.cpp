@@ -31,7 +31,6 @@
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
 #include "kernel_table.hpp"
-#include "ordered_contacts.hpp"
 #include "scratch_records.hpp"
 
 namespace collide {
@@ -51,18 +50,6 @@ struct Solver::Impl {
   detail::ScratchRecords<PackedSphere<double>> sphere_d;
   detail::ScratchRecords<PackedParticle<float>> particle_f;
   detail::ScratchRecords<PackedParticle<double>> particle_d;
-
-  detail::OrderedContacts<float> ordered_f;
-  detail::OrderedContacts<double> ordered_d;
-
-  template <class T>
-  detail::OrderedContacts<T>& ordered() {
-    if constexpr (std::is_same_v<T, float>) {
-      return ordered_f;
-    } else {
-      return ordered_d;
-    }
-  }
 
   template <class Record>
   detail::ScratchRecords<Record>& buffer() {
@@ -249,10 +236,6 @@ std::size_t scattered_contacts(const Schedule& schedule) {
 /// (README, "Performance"): at a quarter as many scattered contacts as
 /// bodies the two cost about the same; below that, or in scenes that stream
 /// (pairs), the SoA arrays are used in place.
-/// Scattered contacts above which a packed solve copies the contacts into
-/// schedule order (ordered_contacts.hpp): below, the copy costs more than the
-/// scattered reads it saves.
-constexpr std::size_t kOrderContactsAbove = 4096;
 
 bool should_pack(BodyLayout layout, const Schedule& schedule, std::size_t bodies) {
   switch (layout) {
@@ -303,28 +286,8 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   impl_->arena->execute([&] { pack(bodies, packed); });
   job.packed = true;
   detail::set_packed(job, packed);
-  SolveStats stats = run_packed(job, bodies.count, schedule);
+  SolveStats stats = detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
-  return stats;
-}
-
-/// The kernel on packed bodies (the mutex is held). Scattered contacts are
-/// copied into schedule order first (ordered_contacts.hpp), so that the
-/// kernel streams them, and J is put back into input order after.
-template <class T>
-SolveStats Solver::run_packed(detail::KernelJob<T> job, std::size_t body_count, const Schedule& schedule) const {
-  if (detail::scattered_contacts(schedule) < detail::kOrderContactsAbove) {
-    return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, body_count, schedule);
-  }
-  detail::OrderedContacts<T>& ordered = impl_->ordered<T>();
-  const std::size_t n = job.contacts.count;
-  const ImpulseView<T> out = job.impulses;
-  impl_->arena->execute([&] { job.contacts = ordered.gather(job.contacts, schedule.order()); });
-  job.impulses = ordered.impulses(n);
-  job.order = ordered.identity(n);
-  SolveStats stats =
-      detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, body_count, schedule, true);
-  impl_->arena->execute([&] { ordered.scatter(job.impulses, out, schedule.order()); });
   return stats;
 }
 
@@ -334,8 +297,9 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
-  const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
-  return run_packed(job, bodies.count, schedule);
+  // The caller's records are solved in place: no buffer of the solver's is
+  // used, so solves on one Solver may run at once, as on SoA views.
+  return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
 }
 
 template <class T>

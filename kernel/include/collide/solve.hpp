@@ -19,11 +19,6 @@
 #include "collide/schedule.hpp"
 
 namespace collide {
-namespace detail {
-template <class T>
-struct KernelJob;
-}  // namespace detail
-
 /// Which implementation of the kernel runs.
 enum class Path {
   scalar,  ///< one contact at a time (lane width 1)
@@ -168,8 +163,6 @@ class Solver {
   template <class Record, class View, class T>
   SolveStats solve_soa(Model model, const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                        const Schedule& schedule) const;
-  template <class T>
-  SolveStats run_packed(detail::KernelJob<T> job, std::size_t body_count, const Schedule& schedule) const;
   template <class Record, class T>
   SolveStats solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                           const ImpulseView<T>& impulses, const Schedule& schedule) const;
