@@ -202,25 +202,28 @@ def packed_empty(n, model="rigid", dtype=_np.float32, *, columns=False):
     return records
 
 
-def pack(bodies, model="auto", *, columns=False):
+def pack(bodies, model="rigid", *, contacts=None, columns=False):
     """Packs :class:`Bodies` into new aligned records (an exact copy of every
-    field the record holds) and returns the :class:`PackedBodies`. ``model``
-    "auto" is the cheapest that fits (as :func:`solve` chooses; the inputs
-    are validated); "sphere" and "particle" must fit the bodies (ValueError
-    otherwise, with the reason), since their records drop the orientation and
-    the unequal moments."""
+    field the record holds) and returns the :class:`PackedBodies`. Rigid
+    records hold everything. Sphere and particle records drop what their
+    model does not read, so they need the model to fit (ValueError with the
+    reason otherwise, as ``solve(..., model=...)``): whether the particle
+    model fits depends on the contacts, so "particle" and "auto" (the
+    cheapest model that fits, as :func:`solve` chooses; the inputs are
+    validated) need ``contacts``."""
     if not isinstance(bodies, Bodies):
         raise TypeError(f"pack: bodies must be collide.Bodies, got {type(bodies).__name__}")
-    if model == "auto":
-        raise_if_invalid = _np.zeros((3, 0), dtype=bodies.dtype)
-        contacts = Contacts(_np.zeros(0, _np.uint32), _np.zeros(0, _np.uint32), raise_if_invalid, raise_if_invalid)
-        model = _collide.choose_model(bodies, contacts)
-    elif model in ("sphere", "particle"):
+    if model in ("auto", "particle") and contacts is None:
+        raise ValueError(f"pack: model '{model}' needs the contacts (whether the particle model fits depends on them)")
+    if contacts is None:
         none = _np.zeros((3, 0), dtype=bodies.dtype)
         contacts = Contacts(_np.zeros(0, _np.uint32), _np.zeros(0, _np.uint32), none, none)
+    if model == "auto":
+        model = _collide.choose_model(bodies, contacts)
+    elif model in ("sphere", "particle"):
         misfit = _collide.model_misfit(bodies, contacts, model)
         if misfit:
-            raise ValueError(f"pack: model '{model}' does not fit the bodies: {misfit}")
+            raise ValueError(f"pack: model '{model}' does not fit the scene: {misfit}")
     packed = PackedBodies(packed_empty(len(bodies), model, bodies.dtype, columns=columns), model=model)
     _collide.pack_into(bodies, packed)
     return packed
