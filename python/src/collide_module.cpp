@@ -254,7 +254,6 @@ py::array impulse_array(const py::object& out, Dtype dtype, std::size_t m) {
   return j;
 }
 
-
 // ---------------------------------------------------------------------------
 // Options.
 // ---------------------------------------------------------------------------
@@ -320,7 +319,9 @@ std::size_t record_align(Model m) {
   }
   return alignof(PackedRigid<T>);
 }
-std::size_t record_align(Model m, Dtype d) { return d == Dtype::f32 ? record_align<float>(m) : record_align<double>(m); }
+std::size_t record_align(Model m, Dtype d) {
+  return d == Dtype::f32 ? record_align<float>(m) : record_align<double>(m);
+}
 
 /// One field of a record: name, byte offset, values (1: a scalar field).
 struct RecordField {
@@ -346,9 +347,12 @@ std::vector<RecordField> record_fields(Model m) {
     case Model::rigid:
       break;
   }
-  return {{"v", offsetof(R, v), 3},         {"w", offsetof(R, w), 3},
-          {"p", offsetof(R, p), 3},         {"q", offsetof(R, q), 4},
-          {"inv_mass", offsetof(R, inv_mass), 1}, {"inv_inertia", offsetof(R, inv_inertia), 3}};
+  return {{"v", offsetof(R, v), 3},
+          {"w", offsetof(R, w), 3},
+          {"p", offsetof(R, p), 3},
+          {"q", offsetof(R, q), 4},
+          {"inv_mass", offsetof(R, inv_mass), 1},
+          {"inv_inertia", offsetof(R, inv_inertia), 3}};
 }
 
 /// The NumPy structured dtype of a record: its fields at the C++ offsets and
@@ -422,8 +426,8 @@ struct PackedBodies {
           found = true;
           model = m;
         }
-        expected += (expected.empty() ? "" : " or ") + std::string("(N, ") + std::to_string(k) + ") for " +
-                    to_string(m);
+        expected +=
+            (expected.empty() ? "" : " or ") + std::string("(N, ") + std::to_string(k) + ") for " + to_string(m);
       }
       if (!found) {
         throw py::type_error(what + " has shape " + shape_text(a) + ", expected " + expected + " records of " +
@@ -439,8 +443,8 @@ struct PackedBodies {
     const auto address = reinterpret_cast<std::uintptr_t>(a.data());
     if (address % align != 0) {
       throw py::type_error(what + " starts " + std::to_string(address % align) + " bytes past a multiple of " +
-                           std::to_string(align) + ", the alignment of " + to_string(model) + " " +
-                           dtype_name(dtype) + " records: allocate them with collide.packed_empty() or collide.pack()");
+                           std::to_string(align) + ", the alignment of " + to_string(model) + " " + dtype_name(dtype) +
+                           " records: allocate them with collide.packed_empty() or collide.pack()");
     }
     records = a;
     count = static_cast<std::size_t>(a.shape(0));
@@ -711,8 +715,8 @@ struct PySolver {
     // a particle solve); the record is built over no impulses and the key
     // set to None.
     const ImpulseView<const T> jc{impacts ? jv.count : 0, {jv.j.x, jv.j.y, jv.j.z}};
-    py::dict d = to_dict(
-        solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));
+    py::dict d =
+        to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));
     if (!impacts) d["impacts"] = py::none();
     return py::make_tuple(j, d);
   }
@@ -860,8 +864,9 @@ py::tuple scene_to_python(const Scene<T>& s, Dtype d) {
 py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
                       bool friction, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris")
+  if (kind != "pairs" && kind != "debris") {
     throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  }
   if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
   GenerateOptions o;
   o.seed = seed;
@@ -1116,13 +1121,12 @@ PYBIND11_MODULE(_collide, m) {
       py::arg("model"), py::arg("dtype"));
   m.def("pack_into", &pack_into, py::arg("bodies"), py::arg("packed"));
   m.def(
-      "unpack_into",
-      [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, false); },
+      "unpack_into", [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, false); },
       py::arg("packed"), py::arg("bodies"));
   m.def(
       "unpack_velocities_into",
-      [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, true); },
-      py::arg("packed"), py::arg("bodies"));
+      [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, true); }, py::arg("packed"),
+      py::arg("bodies"));
   m.def(
       "choose_model",
       [](const Bodies& bodies, const Contacts& contacts) {
@@ -1234,7 +1238,8 @@ PYBIND11_MODULE(_collide, m) {
       py::arg("isa"));
   m.def("best_isa", [] { return std::string(c::to_string(c::best_isa())); });
 
-  py::register_exception_translator([](std::exception_ptr p) {
+  // By value: pybind11's translator is a void (*)(std::exception_ptr).
+  py::register_exception_translator([](std::exception_ptr p) {  // NOLINT(performance-unnecessary-value-param)
     try {
       if (p) std::rethrow_exception(p);
     } catch (const c::SceneError& e) {
