@@ -17,6 +17,11 @@
 // * The GIL is released around every long C++ call (solve, reference,
 //   report, generate, file I/O). The ndarrays stay referenced by the Bodies
 //   and Contacts objects (and the call's arguments) meanwhile.
+// * Packed bodies (PackedBodies) are the caller's record array, structured
+//   (packed_dtype(), built here from the C++ offsets) or (N, k) floats,
+//   checked for dtype, width, contiguity and alignment (TypeError) and
+//   solved in place by the library's packed overloads; values are checked by
+//   validate() for packed views, so records and SoA get the same messages.
 // * The statistics dict is collide::solve_record (collide/check.hpp), the
 //   record `collide solve --stats` prints, and the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises.
@@ -293,34 +298,28 @@ SolverOptions solver_options(const std::string& path, int threads, const py::obj
 // Packed bodies over the caller's records (collide/packed.hpp).
 // ---------------------------------------------------------------------------
 
-template <class T>
-std::size_t record_size(Model m) {
+/// f(Record{}) for the record type of model m with values of type T.
+template <class T, class F>
+auto with_record_type(Model m, F&& f) {
   switch (m) {
     case Model::sphere:
-      return sizeof(PackedSphere<T>);
+      return f(PackedSphere<T>{});
     case Model::particle:
-      return sizeof(PackedParticle<T>);
+      return f(PackedParticle<T>{});
     case Model::rigid:
       break;
   }
-  return sizeof(PackedRigid<T>);
+  return f(PackedRigid<T>{});
 }
-std::size_t record_size(Model m, Dtype d) { return d == Dtype::f32 ? record_size<float>(m) : record_size<double>(m); }
-
-template <class T>
-std::size_t record_align(Model m) {
-  switch (m) {
-    case Model::sphere:
-      return alignof(PackedSphere<T>);
-    case Model::particle:
-      return alignof(PackedParticle<T>);
-    case Model::rigid:
-      break;
-  }
-  return alignof(PackedRigid<T>);
+template <class F>
+auto with_record_type(Model m, Dtype d, F&& f) {
+  return d == Dtype::f32 ? with_record_type<float>(m, f) : with_record_type<double>(m, f);
+}
+std::size_t record_size(Model m, Dtype d) {
+  return with_record_type(m, d, [](const auto& r) { return sizeof(r); });
 }
 std::size_t record_align(Model m, Dtype d) {
-  return d == Dtype::f32 ? record_align<float>(m) : record_align<double>(m);
+  return with_record_type(m, d, [](const auto& r) { return alignof(std::decay_t<decltype(r)>); });
 }
 
 /// One field of a record: name, byte offset, values (1: a scalar field).
