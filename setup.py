@@ -1,10 +1,18 @@
 """Builds the extension collide._collide with CMake for `pip install .`.
 
 Only the library and the module are built (no tests, benchmarks, CLI or
-examples), in Release, with ccache when it is on PATH, for the interpreter
-running pip. The build directory is build/pip-<python tag> under the source
-tree (kept between installs, so a second install recompiles only what
-changed); COLLIDE_PIP_BUILD_DIR overrides it.
+examples), in Release, for the interpreter running pip. The build directory
+is build-pip-<python tag> under the source tree (kept between installs, so a
+second install recompiles only what changed); COLLIDE_PIP_BUILD_DIR
+overrides it.
+
+With ccache on PATH every compile goes through it, with CCACHE_BASEDIR set
+to the source tree unless the environment sets one: paths are then hashed
+relative to the build directory, and since build-pip-<tag> sits one level
+under the root like the normal build/, the library's objects (the kernel
+objects take minutes each) are the ones the normal build already compiled,
+even for a copy of the checkout elsewhere (scripts/build.sh uses ccache the
+same way).
 """
 
 import os
@@ -27,7 +35,7 @@ class CMakeExtension(Extension):
 class CMakeBuild(build_ext):
     def build_extension(self, ext):
         tag = sysconfig.get_config_var("SOABI") or "py"
-        build_dir = os.environ.get("COLLIDE_PIP_BUILD_DIR", os.path.join(ROOT, "build", "pip-" + tag))
+        build_dir = os.environ.get("COLLIDE_PIP_BUILD_DIR", os.path.join(ROOT, "build-pip-" + tag))
         configure = [
             "cmake", "-S", ROOT, "-B", build_dir,
             "-DCMAKE_BUILD_TYPE=Release",
@@ -35,11 +43,13 @@ class CMakeBuild(build_ext):
             "-DCOLLIDE_BUILD_EXAMPLES=OFF", "-DCOLLIDE_INSTALL=OFF", "-DCOLLIDE_BUILD_PYTHON=ON",
             "-DPYTHON_EXECUTABLE=" + sys.executable, "-DPython_EXECUTABLE=" + sys.executable,
         ]
+        env = dict(os.environ)
         if shutil.which("ccache"):
             configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")
-        subprocess.check_call(configure)
+            env.setdefault("CCACHE_BASEDIR", ROOT)
+        subprocess.check_call(configure, env=env)
         jobs = str(os.cpu_count() or 1)
-        subprocess.check_call(["cmake", "--build", build_dir, "--target", "_collide", "-j", jobs])
+        subprocess.check_call(["cmake", "--build", build_dir, "--target", "_collide", "-j", jobs], env=env)
         built = os.path.join(build_dir, "python", "collide", os.path.basename(self.get_ext_filename(ext.name)))
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)

@@ -8,9 +8,11 @@ set -euo pipefail
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
 # tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
 # no network (venv, setuptools, pip).
+# ccache: scripts/build.sh and setup.py compile through it when present, so the
+# pip install test reuses the normal build's objects (python/CMakeLists.txt).
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
 # scripts/ci-sanitizers.sh.
-packages=(g++ cmake make pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
+packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
   clang-14 libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip)
 

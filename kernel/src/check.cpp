@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <limits>
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_reduce.h>
+
 #include "collide/error_bound.hpp"
 
 namespace collide {
@@ -76,11 +79,22 @@ ImpulseCheck check_impulses(const ImpulseView<const T>& j, const ImpulseView<con
 
 template <class T>
 std::size_t count_impacts(const ImpulseView<const T>& j) {
-  std::size_t impacts = 0;
-  for (std::size_t k = 0; k < j.count; ++k) {
-    impacts += (j.j.x[k] != T(0) || j.j.y[k] != T(0) || j.j.z[k] != T(0)) ? 1 : 0;
-  }
-  return impacts;
+  // Bitwise or, not ||: no branch, so the loop vectorises. In parallel above a
+  // few chunks: at a million contacts the pass is bound by one core's memory
+  // bandwidth (a sum of counts: the same for any split).
+  const auto count = [&](std::size_t k0, std::size_t k1) {
+    std::size_t impacts = 0;
+    for (std::size_t k = k0; k < k1; ++k) {
+      impacts += static_cast<std::size_t>((j.j.x[k] != T(0)) | (j.j.y[k] != T(0)) | (j.j.z[k] != T(0)));
+    }
+    return impacts;
+  };
+  constexpr std::size_t kGrain = std::size_t{1} << 15;
+  if (j.count < 2 * kGrain) return count(0, j.count);
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, j.count, kGrain), std::size_t{0},
+      [&](const tbb::blocked_range<std::size_t>& r, std::size_t n) { return n + count(r.begin(), r.end()); },
+      [](std::size_t x, std::size_t y) { return x + y; });
 }
 
 template <class T>

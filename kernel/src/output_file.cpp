@@ -73,16 +73,19 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   }
   switch (names_a_descriptor(path_) ? Target::direct : classify(path_)) {
     case Target::directory:
-      throw SceneError(path_, "cannot write: is a directory");
+      throw SceneError(path_, "cannot write: is a directory", EISDIR);
     case Target::direct: {
       // No O_TRUNC or O_CREAT: the node exists and is not a file to replace.
       const int fd = ::open(path_.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
-      if (fd < 0) throw SceneError(path_, errno_text("cannot open for writing", errno));
+      if (fd < 0) {
+        const int err = errno;
+        throw SceneError(path_, errno_text("cannot open for writing", err), err);
+      }
       file_ = ::fdopen(fd, "wb");
       if (file_ == nullptr) {
         const int err = errno;
         ::close(fd);
-        throw SceneError(path_, errno_text("cannot open for writing", err));
+        throw SceneError(path_, errno_text("cannot open for writing", err), err);
       }
       return;
     }
@@ -97,8 +100,11 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   std::string templ = (dir.empty() ? std::string() : dir + "/") + "." + dest.filename().string() + ".tmp-XXXXXX";
   const int fd = ::mkstemp(templ.data());
   if (fd < 0) {
-    throw SceneError(path_, "cannot create a temporary file in '" + (dir.empty() ? std::string(".") : dir) +
-                                "': " + std::strerror(errno));
+    const int err = errno;
+    throw SceneError(
+        path_,
+        "cannot create a temporary file in '" + (dir.empty() ? std::string(".") : dir) + "': " + std::strerror(err),
+        err);
   }
   temp_path_ = templ;
   file_ = ::fdopen(fd, "wb");
@@ -106,7 +112,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
     const int err = errno;
     ::close(fd);
     ::unlink(temp_path_.c_str());
-    throw SceneError(path_, errno_text("cannot open a temporary file", err));
+    throw SceneError(path_, errno_text("cannot open a temporary file", err), err);
   }
 }
 

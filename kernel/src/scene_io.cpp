@@ -90,6 +90,11 @@ SceneError::SceneError(std::string file, std::string reason)
       file_(std::move(file)),
       reason_(std::move(reason)) {}
 
+SceneError::SceneError(std::string file, std::string reason, int os_error)
+    : SceneError(std::move(file), std::move(reason)) {
+  os_error_ = os_error;
+}
+
 // ---------------------------------------------------------------------------
 // BodyTable
 // ---------------------------------------------------------------------------
@@ -143,14 +148,20 @@ class FileBuffer {
 
   explicit FileBuffer(const std::string& path) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw SceneError(path, std::string("cannot open: ") + std::strerror(errno));
+    if (fd < 0) {
+      const int err = errno;
+      throw SceneError(path, std::string("cannot open: ") + std::strerror(err), err);
+    }
     struct FdCloser {
       int fd;
       ~FdCloser() { ::close(fd); }
     } closer{fd};
     struct stat st {};
-    if (::fstat(fd, &st) != 0) throw SceneError(path, std::string("cannot stat: ") + std::strerror(errno));
-    if (S_ISDIR(st.st_mode)) throw SceneError(path, "cannot read: is a directory");
+    if (::fstat(fd, &st) != 0) {
+      const int err = errno;
+      throw SceneError(path, std::string("cannot stat: ") + std::strerror(err), err);
+    }
+    if (S_ISDIR(st.st_mode)) throw SceneError(path, "cannot read: is a directory", EISDIR);
     if (S_ISREG(st.st_mode) && st.st_size > 0) {
       size_ = static_cast<std::size_t>(st.st_size);
       void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
@@ -165,8 +176,9 @@ class FileBuffer {
     for (;;) {
       const ssize_t got = ::read(fd, heap_.get() + size_, capacity - size_);
       if (got < 0) {
-        if (errno == EINTR) continue;
-        throw SceneError(path, std::string("read error: ") + std::strerror(errno));
+        const int err = errno;
+        if (err == EINTR) continue;
+        throw SceneError(path, std::string("read error: ") + std::strerror(err), err);
       }
       if (got == 0) break;
       size_ += static_cast<std::size_t>(got);

@@ -60,13 +60,38 @@ class Contacts:
     ) -> None: ...
     def __len__(self) -> int: ...
 
+class PackedBodies:
+    """N packed bodies over the caller's records (no copy): a 1-D array of
+    packed_dtype(model, dtype), or a C-contiguous (N, k) float array whose
+    rows are the records; aligned as the record type says (packed_empty and
+    pack allocate so). The record type is the model; v and w are updated in
+    place. The field properties are views of the records."""
+
+    records: npt.NDArray[Any]
+    model: Literal["rigid", "sphere", "particle"]
+    dtype: np.dtype[Any]
+    record_dtype: np.dtype[Any]
+    structured: npt.NDArray[Any]
+    v: FloatArray
+    w: FloatArray
+    p: FloatArray
+    q: FloatArray
+    inv_mass: FloatArray
+    inv_inertia: FloatArray
+    def __init__(self, records: npt.NDArray[Any], *, model: ModelName = "auto") -> None: ...
+    def __len__(self) -> int: ...
+    def unpack(self, into: Bodies | None = None) -> Bodies: ...
+    def unpack_velocities(self, into: Bodies) -> Bodies: ...
+
+AnyBodies = Bodies | PackedBodies
+
 class Schedule:
     """The batches of a contact set; reusable while indices and inverse masses stay."""
 
     batches: int
     largest_batch: int
     build_seconds: float
-    def __init__(self, bodies: Bodies, contacts: Contacts) -> None: ...
+    def __init__(self, bodies: AnyBodies, contacts: Contacts) -> None: ...
 
 class Solver:
     """A reusable solver (its thread arena and options) for frame loops."""
@@ -81,13 +106,14 @@ class Solver:
     ) -> None: ...
     def solve(
         self,
-        bodies: Bodies,
+        bodies: AnyBodies,
         contacts: Contacts,
         *,
         model: ModelName = "auto",
         schedule: Schedule | None = None,
         out: FloatArray | None = None,
         check: bool = True,
+        impacts: bool = True,
     ) -> tuple[FloatArray, dict[str, Any]]: ...
 
 class Reference:
@@ -101,7 +127,7 @@ class Reference:
     def __len__(self) -> int: ...
 
 def solve(
-    bodies: Bodies,
+    bodies: AnyBodies,
     contacts: Contacts,
     *,
     model: ModelName = "auto",
@@ -112,8 +138,9 @@ def solve(
     schedule: Schedule | None = None,
     out: FloatArray | None = None,
     check: bool = True,
+    impacts: bool = True,
 ) -> tuple[FloatArray, dict[str, Any]]: ...
-def reference_solve(bodies: Bodies, contacts: Contacts) -> Reference: ...
+def reference_solve(bodies: AnyBodies, contacts: Contacts) -> Reference: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
 def generate(
     kind: Literal["pairs", "debris"],
@@ -125,7 +152,22 @@ def generate(
     dtype: type[Float] | np.dtype[Any] = ...,
 ) -> tuple[Bodies, Contacts]: ...
 def read_scene(bodies_csv: str, contacts_csv: str, dtype: type[Float] | np.dtype[Any] = ...) -> tuple[Bodies, Contacts]: ...
-def write_scene(bodies_csv: str, contacts_csv: str, bodies: Bodies, contacts: Contacts) -> None: ...
+def write_scene(bodies_csv: str, contacts_csv: str, bodies: AnyBodies, contacts: Contacts) -> None: ...
+def packed_dtype(model: Literal["rigid", "sphere", "particle"] = "rigid", dtype: type[Float] | np.dtype[Any] = ...) -> np.dtype[Any]: ...
+def packed_empty(
+    n: int,
+    model: Literal["rigid", "sphere", "particle"] = "rigid",
+    dtype: type[Float] | np.dtype[Any] = ...,
+    *,
+    columns: bool = False,
+) -> npt.NDArray[Any]: ...
+def pack(
+    bodies: Bodies,
+    model: ModelName = "rigid",
+    *,
+    contacts: Contacts | None = None,
+    columns: bool = False,
+) -> PackedBodies: ...
 def from_physical(
     m: npt.ArrayLike,
     inertia: npt.ArrayLike,

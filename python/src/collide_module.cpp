@@ -17,6 +17,11 @@
 // * The GIL is released around every long C++ call (solve, reference,
 //   report, generate, file I/O). The ndarrays stay referenced by the Bodies
 //   and Contacts objects (and the call's arguments) meanwhile.
+// * Packed bodies (PackedBodies) are the caller's record array, structured
+//   (packed_dtype(), built here from the C++ offsets) or (N, k) floats,
+//   checked for dtype, width, contiguity and alignment (TypeError) and
+//   solved in place by the library's packed overloads; values are checked by
+//   validate() for packed views, so records and SoA get the same messages.
 // * The statistics dict is collide::solve_record (collide/check.hpp), the
 //   record `collide solve --stats` prints, and the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises.
@@ -28,12 +33,14 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -43,6 +50,7 @@
 #include "collide/generate.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
+#include "collide/packed.hpp"
 #include "collide/reference.hpp"
 #include "collide/report.hpp"
 #include "collide/scene.hpp"
@@ -251,11 +259,6 @@ py::array impulse_array(const py::object& out, Dtype dtype, std::size_t m) {
   return j;
 }
 
-template <class T>
-void validate_or_throw(const Bodies& bodies, const Contacts& contacts, const ImpulseView<T>& j) {
-  if (const Validation v = validate(bodies.view<T>(), contacts.view<T>(), j); !v) throw py::value_error(v.message);
-}
-
 // ---------------------------------------------------------------------------
 // Options.
 // ---------------------------------------------------------------------------
@@ -292,8 +295,332 @@ SolverOptions solver_options(const std::string& path, int threads, const py::obj
 }
 
 // ---------------------------------------------------------------------------
+// Packed bodies over the caller's records (collide/packed.hpp).
+// ---------------------------------------------------------------------------
+
+/// f(Record{}) for the record type of model m with values of type T.
+template <class T, class F>
+auto with_record_type(Model m, F&& f) {
+  switch (m) {
+    case Model::sphere:
+      return f(PackedSphere<T>{});
+    case Model::particle:
+      return f(PackedParticle<T>{});
+    case Model::rigid:
+      break;
+  }
+  return f(PackedRigid<T>{});
+}
+template <class F>
+auto with_record_type(Model m, Dtype d, F&& f) {
+  return d == Dtype::f32 ? with_record_type<float>(m, f) : with_record_type<double>(m, f);
+}
+std::size_t record_size(Model m, Dtype d) {
+  return with_record_type(m, d, [](const auto& r) { return sizeof(r); });
+}
+std::size_t record_align(Model m, Dtype d) {
+  return with_record_type(m, d, [](const auto& r) { return alignof(std::decay_t<decltype(r)>); });
+}
+
+/// One field of a record: name, byte offset, values (1: a scalar field).
+struct RecordField {
+  const char* name;
+  std::size_t offset;
+  std::size_t values;
+};
+
+template <class T>
+std::vector<RecordField> record_fields(Model m) {
+  using R = PackedRigid<T>;
+  using S = PackedSphere<T>;
+  using P = PackedParticle<T>;
+  switch (m) {
+    case Model::sphere:
+      return {{"v", offsetof(S, v), 3},
+              {"w", offsetof(S, w), 3},
+              {"p", offsetof(S, p), 3},
+              {"inv_mass", offsetof(S, inv_mass), 1},
+              {"inv_inertia", offsetof(S, inv_inertia), 1}};
+    case Model::particle:
+      return {{"v", offsetof(P, v), 3}, {"inv_mass", offsetof(P, inv_mass), 1}};
+    case Model::rigid:
+      break;
+  }
+  return {{"v", offsetof(R, v), 3},
+          {"w", offsetof(R, w), 3},
+          {"p", offsetof(R, p), 3},
+          {"q", offsetof(R, q), 4},
+          {"inv_mass", offsetof(R, inv_mass), 1},
+          {"inv_inertia", offsetof(R, inv_inertia), 3}};
+}
+
+/// The NumPy structured dtype of a record: its fields at the C++ offsets and
+/// itemsize sizeof(Record), padding included.
+py::dtype record_dtype(Model m, Dtype d) {
+  const std::vector<RecordField> fields = d == Dtype::f32 ? record_fields<float>(m) : record_fields<double>(m);
+  py::list names, formats, offsets;
+  for (const RecordField& f : fields) {
+    names.append(f.name);
+    if (f.values == 1) {
+      formats.append(numpy_dtype(d));
+    } else {
+      formats.append(py::make_tuple(numpy_dtype(d), py::make_tuple(f.values)));
+    }
+    offsets.append(f.offset);
+  }
+  py::dict spec;
+  spec["names"] = names;
+  spec["formats"] = formats;
+  spec["offsets"] = offsets;
+  spec["itemsize"] = record_size(m, d);
+  return py::dtype::from_args(spec);
+}
+
+constexpr std::array<Model, 3> kModels = {Model::rigid, Model::sphere, Model::particle};
+
+/// N packed bodies over the caller's records, with no copy: a 1-D array of
+/// the record dtype (packed_dtype()), or a C-contiguous (N, k) float array
+/// whose rows are the records (k values of T per record, padding included).
+/// The record type is the model. v and w are updated in place.
+struct PackedBodies {
+  py::array records;
+  Model model = Model::rigid;
+  Dtype dtype = Dtype::f32;
+  std::size_t count = 0;
+
+  PackedBodies(const py::object& records_in, const std::string& model_name) {
+    const std::string what = "packed.records";
+    if (!py::isinstance<py::array>(records_in)) {
+      throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(records_in)));
+    }
+    const auto a = py::reinterpret_borrow<py::array>(records_in);
+    const std::optional<Model> requested = parse_model(model_name);
+    const auto candidates = [&] {
+      return requested ? std::vector<Model>{*requested} : std::vector<Model>(kModels.begin(), kModels.end());
+    };
+    bool found = false;
+    if (a.dtype().kind() == 'V') {
+      for (const Dtype d : {Dtype::f32, Dtype::f64}) {
+        for (const Model m : candidates()) {
+          if (!found && a.dtype().equal(record_dtype(m, d))) {
+            found = true;
+            model = m;
+            dtype = d;
+          }
+        }
+      }
+      if (!found) {
+        throw py::type_error(what + " has dtype " + text(a.dtype()) + ", which is not " +
+                             (requested ? "collide.packed_dtype('" + model_name + "', float32 or float64)"
+                                        : std::string("a record dtype of collide.packed_dtype()")));
+      }
+      if (a.ndim() != 1) throw py::type_error(what + " has shape " + shape_text(a) + ", expected (N,) records");
+    } else {
+      dtype = scene_dtype(what, a);
+      const std::size_t t = dtype == Dtype::f32 ? sizeof(float) : sizeof(double);
+      std::string expected;
+      for (const Model m : candidates()) {
+        const std::size_t k = record_size(m, dtype) / t;
+        if (!found && a.ndim() == 2 && static_cast<std::size_t>(a.shape(1)) == k) {
+          found = true;
+          model = m;
+        }
+        expected +=
+            (expected.empty() ? "" : " or ") + std::string("(N, ") + std::to_string(k) + ") for " + to_string(m);
+      }
+      if (!found) {
+        throw py::type_error(what + " has shape " + shape_text(a) + ", expected " + expected + " records of " +
+                             dtype_name(dtype));
+      }
+    }
+    const int flags = a.flags();
+    if ((flags & py::array::c_style) == 0) throw py::type_error(what + " must be C-contiguous");
+    if ((flags & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) == 0) {
+      throw py::type_error(what + " must be writeable: the solve updates v and w in place");
+    }
+    const std::size_t align = record_align(model, dtype);
+    const auto address = reinterpret_cast<std::uintptr_t>(a.data());
+    if (address % align != 0) {
+      throw py::type_error(what + " starts " + std::to_string(address % align) + " bytes past a multiple of " +
+                           std::to_string(align) + ", the alignment of " + to_string(model) + " " + dtype_name(dtype) +
+                           " records: allocate them with collide.packed_empty() or collide.pack()");
+    }
+    records = a;
+    count = static_cast<std::size_t>(a.shape(0));
+    if (count > std::numeric_limits<BodyIndex>::max()) throw py::value_error("packed: more than 2^32 - 1 bodies");
+  }
+
+  template <class Record>
+  PackedView<Record> view() const {
+    return {count, data<Record>(records)};
+  }
+};
+
+template <class View>
+struct RecordOf;
+template <class R>
+struct RecordOf<PackedView<R>> {
+  using type = R;
+};
+
+/// f(PackedView<Record>) for the records' type, with value type T.
+template <class T, class F>
+decltype(auto) with_records(const PackedBodies& b, F&& f) {
+  switch (b.model) {
+    case Model::sphere:
+      return f(b.view<PackedSphere<T>>());
+    case Model::particle:
+      return f(b.view<PackedParticle<T>>());
+    case Model::rigid:
+      break;
+  }
+  return f(b.view<PackedRigid<T>>());
+}
+
+/// The SoA view of `bodies` for the model of records R.
+template <class R, class T>
+auto soa_view_for(const BodyView<T>& bodies) {
+  if constexpr (std::is_same_v<R, PackedSphere<T>>) {
+    return sphere_view(bodies);
+  } else if constexpr (std::is_same_v<R, PackedParticle<T>>) {
+    return particle_view(bodies);
+  } else {
+    return bodies;
+  }
+}
+
+void require_same_scene(const Bodies& bodies, const PackedBodies& packed) {
+  if (bodies.dtype != packed.dtype) {
+    throw py::type_error(std::string("bodies are ") + dtype_name(bodies.dtype) + " but the records are " +
+                         dtype_name(packed.dtype));
+  }
+  if (bodies.count != packed.count) {
+    throw py::value_error("bodies has " + std::to_string(bodies.count) + " bodies but the records " +
+                          std::to_string(packed.count));
+  }
+}
+
+/// Bodies into records (an exact copy): every field the record holds.
+void pack_into(const Bodies& bodies, const PackedBodies& packed) {
+  require_same_scene(bodies, packed);
+  const auto run = [&](auto tag) {
+    using T = decltype(tag);
+    const BodyView<T> bv = bodies.view<T>();
+    with_records<T>(packed, [&](const auto& records) {
+      using R = typename RecordOf<std::decay_t<decltype(records)>>::type;
+      const auto from = soa_view_for<R>(bv);
+      py::gil_scoped_release release;
+      pack(from, records);
+    });
+  };
+  packed.dtype == Dtype::f32 ? run(float{}) : run(double{});
+}
+
+/// Records into bodies (an exact copy): every field the record holds, or
+/// only v and w of movable bodies.
+void unpack_into(const PackedBodies& packed, const Bodies& bodies, bool velocities_only) {
+  require_same_scene(bodies, packed);
+  if (!velocities_only) {
+    for (const auto& [name, a] : {std::pair<const char*, const py::array*>{"inv_mass", &bodies.inv_mass},
+                                  {"inv_inertia", &bodies.inv_inertia},
+                                  {"q", &bodies.q},
+                                  {"p", &bodies.p}}) {
+      if ((a->flags() & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) == 0) {
+        throw py::type_error(std::string("bodies.") + name + " must be writeable to unpack into it");
+      }
+    }
+  }
+  const auto run = [&](auto tag) {
+    using T = decltype(tag);
+    const BodyView<T> bv = bodies.view<T>();
+    with_records<T>(packed, [&](const auto& records) {
+      using R = typename RecordOf<std::decay_t<decltype(records)>>::type;
+      const auto to = soa_view_for<R>(bv);
+      py::gil_scoped_release release;
+      if (velocities_only) {
+        unpack_velocities(records, to);
+      } else {
+        unpack(records, to);
+      }
+    });
+  };
+  packed.dtype == Dtype::f32 ? run(float{}) : run(double{});
+}
+
+void require_same_dtype(const PackedBodies& bodies, const Contacts& contacts) {
+  if (bodies.dtype != contacts.dtype) {
+    throw py::type_error(std::string("bodies are ") + dtype_name(bodies.dtype) + " but contacts are " +
+                         dtype_name(contacts.dtype) + ": one precision per solve");
+  }
+}
+
+// ---------------------------------------------------------------------------
 // Schedule and solver.
 // ---------------------------------------------------------------------------
+
+// The steps of a solve for each kind of bodies: SoA (Bodies) or packed.
+
+/// The schedule reads only the inverse masses (immovable bodies do not
+/// conflict); packed records give them through a copy of that one column.
+template <class T>
+void build_schedule(Schedule& schedule, const ContactView<T>& cv, const Bodies& b) {
+  schedule.build(cv, b.view<T>());
+}
+template <class T>
+void build_schedule(Schedule& schedule, const ContactView<T>& cv, const PackedBodies& b) {
+  std::vector<T> inv_mass(b.count);
+  with_records<T>(b, [&](const auto& records) {
+    for (std::size_t i = 0; i < records.count; ++i) inv_mass[i] = records.bodies[i].inv_mass;
+  });
+  schedule.build(cv, b.count, inv_mass.data());
+}
+
+template <class T>
+Validation validate_values(const Bodies& b, const ContactView<T>& cv, const ImpulseView<T>& jv) {
+  return validate(b.view<T>(), cv, jv);
+}
+template <class T>
+Validation validate_values(const PackedBodies& b, const ContactView<T>& cv, const ImpulseView<T>& jv) {
+  return with_records<T>(b, [&](const auto& records) { return validate(records, cv, jv); });
+}
+
+/// The model of a solve of SoA bodies: the requested one (which must fit
+/// when `check`), else the cheapest that fits.
+template <class T>
+Model solve_model(const Bodies& b, const ContactView<T>& cv, const std::optional<Model>& requested, bool check) {
+  const BodyView<T> bv = b.view<T>();
+  if (!requested) return choose_model(bv, cv);
+  const std::string misfit = check ? model_misfit(*requested, bv, cv) : std::string();
+  if (!misfit.empty()) {
+    throw py::value_error(std::string("model '") + to_string(*requested) + "' does not fit the scene: " + misfit);
+  }
+  return *requested;
+}
+/// Packed records: the record type is the model.
+template <class T>
+Model solve_model(const PackedBodies& b, const ContactView<T>&, const std::optional<Model>& requested, bool) {
+  if (requested && *requested != b.model) {
+    throw py::value_error(std::string("model '") + to_string(*requested) + "' does not match the records: they are " +
+                          to_string(b.model) + " records, and the record type is the model");
+  }
+  return b.model;
+}
+
+template <class T>
+SolveStats run_solve(const Solver& solver, Model model, const Bodies& b, const ContactView<T>& cv,
+                     const ImpulseView<T>& jv, const Schedule& schedule) {
+  return solver.solve(model, b.view<T>(), cv, jv, schedule);
+}
+template <class T>
+SolveStats run_solve(const Solver& solver, Model, const PackedBodies& b, const ContactView<T>& cv,
+                     const ImpulseView<T>& jv, const Schedule& schedule) {
+  return with_records<T>(b, [&](const auto& records) { return solver.solve(records, cv, jv, schedule); });
+}
+
+template <class T, class B>
+void validate_or_throw(const B& bodies, const Contacts& contacts, const ImpulseView<T>& j) {
+  if (const Validation v = validate_values<T>(bodies, contacts.view<T>(), j); !v) throw py::value_error(v.message);
+}
 
 /// A schedule built for one set of contacts and bodies; reusable while the
 /// indices and inverse masses do not change (a frame loop over velocities).
@@ -302,18 +629,32 @@ struct PySchedule {
   std::size_t contacts = 0, bodies = 0;
   double build_seconds = 0;
 
-  template <class T>
-  void build(const Bodies& b, const Contacts& c) {
+  template <class T, class B>
+  void build(const B& b, const Contacts& c) {
     const ContactView<T> cv = c.view<T>();
-    const BodyView<T> bv = b.view<T>();
     const auto t0 = Clock::now();
     {
       py::gil_scoped_release release;
-      schedule.build(cv, bv);
+      build_schedule<T>(schedule, cv, b);
     }
     build_seconds = seconds_since(t0);
     contacts = c.count;
     bodies = b.count;
+  }
+
+  /// A schedule over validated input (it reads the indices).
+  template <class B>
+  static std::unique_ptr<PySchedule> make(const B& bodies, const Contacts& contacts) {
+    require_same_dtype(bodies, contacts);
+    auto s = std::make_unique<PySchedule>();
+    const auto run = [&](auto tag) {
+      using T = decltype(tag);
+      ImpulseBuffer<T> scratch(contacts.count);
+      validate_or_throw<T>(bodies, contacts, scratch.view());
+      s->build<T>(bodies, contacts);
+    };
+    bodies.dtype == Dtype::f32 ? run(float{}) : run(double{});
+    return s;
   }
 };
 
@@ -333,31 +674,25 @@ struct PySolver {
   PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy)
       : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy))) {}
 
-  template <class T>
-  py::tuple solve_t(const Bodies& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
-                    const py::object& out, bool check) {
+  /// Everything is checked before anything is written: layouts (by the
+  /// Bodies/Contacts/PackedBodies constructors and impulse_array), values
+  /// (validate(), or only the indices when !check), the model and the
+  /// schedule's size.
+  template <class T, class B>
+  py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
+                    const py::object& out, bool check, bool impacts) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
     T* jp = data<T>(j);
     const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
-    const BodyView<T> bv = bodies.view<T>();
     const ContactView<T> cv = contacts.view<T>();
     if (check) {
-      validate_or_throw<T>(bodies, contacts, jv);
-    } else if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bv.count); !v) {
+      if (const Validation v = validate_values<T>(bodies, cv, jv); !v) throw py::value_error(v.message);
+    } else if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bodies.count); !v) {
       // Unchecked values are the caller's word; indices never are (memory safety).
       throw py::value_error(v.message);
     }
-    Model model = Model::rigid;
-    if (requested) {
-      model = *requested;
-      const std::string misfit = check ? model_misfit(model, bv, cv) : std::string();
-      if (!misfit.empty()) {
-        throw py::value_error(std::string("model '") + to_string(model) + "' does not fit the scene: " + misfit);
-      }
-    } else {
-      model = choose_model(bv, cv);
-    }
+    const Model model = solve_model<T>(bodies, cv, requested, check);
     PySchedule own;
     if (schedule == nullptr) {
       own.build<T>(bodies, contacts);
@@ -372,19 +707,25 @@ struct PySolver {
     {
       py::gil_scoped_release release;
       const auto t0 = Clock::now();
-      stats = solver->solve(model, bv, cv, jv, schedule->schedule);
+      stats = run_solve<T>(*solver, model, bodies, cv, jv, schedule->schedule);
       kernel_seconds = seconds_since(t0);
     }
-    const ImpulseView<const T> jc{jv.count, {jv.j.x, jv.j.y, jv.j.z}};
-    return py::make_tuple(j, to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds,
-                                                     schedule == &own ? own.build_seconds : 0.0)));
+    // impacts=False: no pass over J (at a million contacts it costs 5-10% of
+    // a particle solve); the record is built over no impulses and the key
+    // set to None.
+    const ImpulseView<const T> jc{impacts ? jv.count : 0, {jv.j.x, jv.j.y, jv.j.z}};
+    py::dict d =
+        to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));
+    if (!impacts) d["impacts"] = py::none();
+    return py::make_tuple(j, d);
   }
 
-  py::tuple solve(const Bodies& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
-                  const py::object& out, bool check) {
+  template <class B>
+  py::tuple solve(const B& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
+                  const py::object& out, bool check, bool impacts) {
     require_same_dtype(bodies, contacts);
-    return bodies.dtype == Dtype::f32 ? solve_t<float>(bodies, contacts, model, schedule, out, check)
-                                      : solve_t<double>(bodies, contacts, model, schedule, out, check);
+    return bodies.dtype == Dtype::f32 ? solve_t<float>(bodies, contacts, model, schedule, out, check, impacts)
+                                      : solve_t<double>(bodies, contacts, model, schedule, out, check, impacts);
   }
 };
 
@@ -522,8 +863,9 @@ py::tuple scene_to_python(const Scene<T>& s, Dtype d) {
 py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
                       bool friction, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris")
+  if (kind != "pairs" && kind != "debris") {
     throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  }
   if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
   GenerateOptions o;
   o.seed = seed;
@@ -543,14 +885,26 @@ py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed
   return d == Dtype::f32 ? run(float{}) : run(double{});
 }
 
-/// Scene-file errors become ValueError with the library's message (file,
-/// line, row, column); I/O failures OSError.
+/// A scene-file error as a Python exception: an operating-system error
+/// (missing file, directory, no permission) as OSError(errno, message,
+/// path), which Python maps to FileNotFoundError, IsADirectoryError,
+/// PermissionError...; a bad content as ValueError with the library's
+/// message (file, line, row, column).
+[[noreturn]] void raise_scene_error(const SceneError& e) {
+  if (e.os_error() != 0) {
+    PyErr_SetObject(PyExc_OSError, py::make_tuple(e.os_error(), e.reason(), e.file()).ptr());
+    throw py::error_already_set();
+  }
+  throw py::value_error(e.what());
+}
+
+/// Runs f, translating scene-file errors (raise_scene_error).
 template <class F>
 auto translate_io(F&& f) {
   try {
     return f();
   } catch (const SceneError& e) {
-    throw py::value_error(e.what());
+    raise_scene_error(e);
   }
 }
 
@@ -740,6 +1094,65 @@ PYBIND11_MODULE(_collide, m) {
       .def_property_readonly("dtype", [](const Bodies& b) { return numpy_dtype(b.dtype); })
       .def("__len__", [](const Bodies& b) { return b.count; });
 
+  py::class_<PackedBodies>(m, "PackedBodies")
+      .def(py::init<const py::object&, const std::string&>(), py::arg("records"), py::kw_only(),
+           py::arg("model") = "auto")
+      .def_readonly("records", &PackedBodies::records)
+      .def_property_readonly("model", [](const PackedBodies& b) { return std::string(c::to_string(b.model)); })
+      .def_property_readonly("dtype", [](const PackedBodies& b) { return numpy_dtype(b.dtype); })
+      .def_property_readonly("record_dtype", [](const PackedBodies& b) { return record_dtype(b.model, b.dtype); })
+      .def("__len__", [](const PackedBodies& b) { return b.count; });
+  m.def(
+      "packed_dtype",
+      [](const std::string& model, const py::object& dtype) {
+        const std::optional<c::Model> mm = parse_model(model);
+        if (!mm) throw py::value_error("packed_dtype needs a model: 'rigid', 'sphere' or 'particle'");
+        return record_dtype(*mm, parse_dtype(dtype));
+      },
+      py::arg("model"), py::arg("dtype"));
+  m.def(
+      "packed_alignment",
+      [](const std::string& model, const py::object& dtype) {
+        const std::optional<c::Model> mm = parse_model(model);
+        if (!mm) throw py::value_error("packed_alignment needs a model: 'rigid', 'sphere' or 'particle'");
+        return record_align(*mm, parse_dtype(dtype));
+      },
+      py::arg("model"), py::arg("dtype"));
+  m.def("pack_into", &pack_into, py::arg("bodies"), py::arg("packed"));
+  m.def(
+      "unpack_into", [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, false); },
+      py::arg("packed"), py::arg("bodies"));
+  m.def(
+      "unpack_velocities_into",
+      [](const PackedBodies& packed, const Bodies& bodies) { unpack_into(packed, bodies, true); }, py::arg("packed"),
+      py::arg("bodies"));
+  m.def(
+      "choose_model",
+      [](const Bodies& bodies, const Contacts& contacts) {
+        require_same_dtype(bodies, contacts);
+        const auto run = [&](auto tag) {
+          using T = decltype(tag);
+          c::ImpulseBuffer<T> scratch(contacts.count);
+          validate_or_throw<T>(bodies, contacts, scratch.view());
+          return std::string(c::to_string(c::choose_model(bodies.view<T>(), contacts.view<T>())));
+        };
+        return bodies.dtype == Dtype::f32 ? run(float{}) : run(double{});
+      },
+      py::arg("bodies"), py::arg("contacts"));
+  m.def(
+      "model_misfit",
+      [](const Bodies& bodies, const Contacts& contacts, const std::string& model) {
+        require_same_dtype(bodies, contacts);
+        const std::optional<c::Model> mm = parse_model(model);
+        if (!mm) throw py::value_error("model_misfit needs a model: 'rigid', 'sphere' or 'particle'");
+        const auto run = [&](auto tag) {
+          using T = decltype(tag);
+          return c::model_misfit(*mm, bodies.view<T>(), contacts.view<T>());
+        };
+        return bodies.dtype == Dtype::f32 ? run(float{}) : run(double{});
+      },
+      py::arg("bodies"), py::arg("contacts"), py::arg("model"));
+
   py::class_<Contacts>(m, "Contacts")
       .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
                     double, const py::object&>(),
@@ -756,22 +1169,8 @@ PYBIND11_MODULE(_collide, m) {
       .def("__len__", [](const Contacts& c) { return c.count; });
 
   py::class_<PySchedule>(m, "Schedule")
-      .def(py::init([](const Bodies& bodies, const Contacts& contacts) {
-             require_same_dtype(bodies, contacts);
-             auto s = std::make_unique<PySchedule>();
-             // The schedule reads indices: they must be in range first.
-             if (bodies.dtype == Dtype::f32) {
-               c::ImpulseBuffer<float> scratch(contacts.count);
-               validate_or_throw<float>(bodies, contacts, scratch.view());
-               s->build<float>(bodies, contacts);
-             } else {
-               c::ImpulseBuffer<double> scratch(contacts.count);
-               validate_or_throw<double>(bodies, contacts, scratch.view());
-               s->build<double>(bodies, contacts);
-             }
-             return s;
-           }),
-           py::arg("bodies"), py::arg("contacts"))
+      .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"))
+      .def(py::init(&PySchedule::make<PackedBodies>), py::arg("bodies"), py::arg("contacts"))
       .def_property_readonly("batches", [](const PySchedule& s) { return s.schedule.batch_count(); })
       .def_property_readonly("largest_batch", [](const PySchedule& s) { return s.schedule.largest_batch(); })
       .def_readonly("build_seconds", &PySchedule::build_seconds);
@@ -783,8 +1182,12 @@ PYBIND11_MODULE(_collide, m) {
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return c::to_string(s.solver->isa()); })
       .def_property_readonly("accuracy", [](const PySolver& s) { return c::to_string(s.solver->options().accuracy); })
-      .def("solve", &PySolver::solve, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("model") = "auto",
-           py::arg("schedule") = nullptr, py::arg("out") = py::none(), py::arg("check") = true);
+      .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
+           py::arg("check") = true, py::arg("impacts") = true)
+      .def("solve", &PySolver::solve<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
+           py::arg("check") = true, py::arg("impacts") = true);
 
   py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
       .def_property_readonly("J", &Reference::j_array)
@@ -834,11 +1237,18 @@ PYBIND11_MODULE(_collide, m) {
       py::arg("isa"));
   m.def("best_isa", [] { return std::string(c::to_string(c::best_isa())); });
 
-  py::register_exception_translator([](std::exception_ptr p) {
+  // By value: pybind11's translator is a void (*)(std::exception_ptr).
+  py::register_exception_translator([](std::exception_ptr p) {  // NOLINT(performance-unnecessary-value-param)
     try {
       if (p) std::rethrow_exception(p);
     } catch (const c::SceneError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      try {
+        raise_scene_error(e);
+      } catch (py::error_already_set& set) {
+        set.restore();
+      } catch (const py::value_error& v) {
+        PyErr_SetString(PyExc_ValueError, v.what());
+      }
     }
   });
 }

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <bit>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -54,6 +55,20 @@ TEST(SceneIo, ErrorCarriesFileLineRowColumn) {
   EXPECT_EQ(e.row(), 2u);
   EXPECT_EQ(e.column(), "vy");
   EXPECT_STREQ(e.what(), "b.csv:4: row 2, column 'vy': not a number: 'x'");
+}
+
+// A file the system cannot give is an operating-system error (the shells
+// raise OSError / FileNotFoundError from os_error()); a bad content is not.
+TEST(SceneIo, MissingFileCarriesTheSystemError) {
+  const std::string missing = (fs::temp_directory_path() / "collide-no-such-dir" / "bodies.csv").string();
+  const SceneError e = expect_scene_error([&] { (void)collide::read_bodies<double>(missing); });
+  EXPECT_EQ(e.os_error(), ENOENT);
+  EXPECT_EQ(e.file(), missing);
+  const SceneError d =
+      expect_scene_error([] { (void)collide::read_bodies<double>(fs::temp_directory_path().string()); });
+  EXPECT_EQ(d.os_error(), EISDIR);
+  const SceneError c = expect_scene_error([] { (void)collide::parse_bodies<float>("m,Ix\n", "b.csv"); });
+  EXPECT_EQ(c.os_error(), 0);
 }
 
 TEST(SceneIo, HeaderErrorHasNoRow) {

@@ -67,12 +67,18 @@ class SceneError : public std::runtime_error {
   SceneError(std::string file, std::size_t line, std::size_t row, std::string column, std::string reason);
   /// An error about the whole file.
   SceneError(std::string file, std::string reason);
+  /// An error of the operating system about the whole file (cannot open,
+  /// read or write it): `os_error` is its errno value.
+  SceneError(std::string file, std::string reason, int os_error);
 
   [[nodiscard]] const std::string& file() const noexcept { return file_; }
   [[nodiscard]] std::size_t line() const noexcept { return line_; }
   [[nodiscard]] std::size_t row() const noexcept { return row_; }
   [[nodiscard]] const std::string& column() const noexcept { return column_; }
   [[nodiscard]] const std::string& reason() const noexcept { return reason_; }
+  /// The errno value of an operating-system error (the file is missing,
+  /// unreadable, a directory...); 0 when the problem is the file's content.
+  [[nodiscard]] int os_error() const noexcept { return os_error_; }
 
  private:
   std::string file_;
@@ -80,6 +86,7 @@ class SceneError : public std::runtime_error {
   std::size_t row_ = kNoRow;
   std::string column_;
   std::string reason_;
+  int os_error_ = 0;
 };
 
 /// The columns of bodies.csv exactly as parsed: column[k][i] is column

@@ -11,6 +11,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/packed.hpp"
 
 namespace collide {
 
@@ -38,6 +39,19 @@ Validation validate(const SphereView<T>& bodies, const ContactView<T>& contacts,
 /// (contacts.c null), since particles never read it.
 template <class T>
 Validation validate(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
+
+/// The same for packed records (collide/packed.hpp), with the rules of the
+/// record's model; messages name the field as the SoA views do
+/// ("bodies.v.x[17]"). The padding of a record is not read.
+template <class T>
+Validation validate(const PackedView<PackedRigid<T>>& bodies, const ContactView<T>& contacts,
+                    const ImpulseView<T>& impulses);
+template <class T>
+Validation validate(const PackedView<PackedSphere<T>>& bodies, const ContactView<T>& contacts,
+                    const ImpulseView<T>& impulses);
+template <class T>
+Validation validate(const PackedView<PackedParticle<T>>& bodies, const ContactView<T>& contacts,
+                    const ImpulseView<T>& impulses);
 
 /// Only what keeps a solve inside the arrays: every index of `a` and `b`
 /// below `body_count`, and a != b. O(count), for callers that vouch for the
