@@ -561,18 +561,14 @@ void require_same_dtype(const PackedBodies& bodies, const Contacts& contacts) {
 // The steps of a solve for each kind of bodies: SoA (Bodies) or packed.
 
 /// The schedule reads only the inverse masses (immovable bodies do not
-/// conflict); packed records give them through a copy of that one column.
+/// conflict); packed records give them in place.
 template <class T>
 void build_schedule(Schedule& schedule, const ContactView<T>& cv, const Bodies& b) {
   schedule.build(cv, b.view<T>());
 }
 template <class T>
 void build_schedule(Schedule& schedule, const ContactView<T>& cv, const PackedBodies& b) {
-  std::vector<T> inv_mass(b.count);
-  with_records<T>(b, [&](const auto& records) {
-    for (std::size_t i = 0; i < records.count; ++i) inv_mass[i] = records.bodies[i].inv_mass;
-  });
-  schedule.build(cv, b.count, inv_mass.data());
+  with_records<T>(b, [&](const auto& records) { schedule.build(cv, records); });
 }
 
 template <class T>
