@@ -136,22 +136,7 @@ COLLIDE_LANE_INLINE Vec3<V> narrow(const Vec3<W>& w) {
 /// (s = 2 / |q|^2), where the fast mode trusts the stored q to be unit.
 template <class W>
 COLLIDE_LANE_INLINE Mat3<W> normalised_rotation(const QuatLanes<W>& q) {
-  const W one(1);
-  const W xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
-  const W xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-  const W wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-  const W s = W(2) / (((q.w * q.w + xx) + yy) + zz);
-  Mat3<W> m;
-  m.r[0][0] = one - s * (yy + zz);
-  m.r[0][1] = s * (xy - wz);
-  m.r[0][2] = s * (xz + wy);
-  m.r[1][0] = s * (xy + wz);
-  m.r[1][1] = one - s * (xx + zz);
-  m.r[1][2] = s * (yz - wx);
-  m.r[2][0] = s * (xz - wy);
-  m.r[2][1] = s * (yz + wx);
-  m.r[2][2] = one - s * (xx + yy);
-  return m;
+  return rotation(q.w, q.x, q.y, q.z, W(2) / (((q.w * q.w + q.x * q.x) + q.y * q.y) + q.z * q.z));
 }
 
 /// The rigid float kernel forms its lever arms h = R^T (r x d) in double
