@@ -121,6 +121,52 @@ COLLIDE_LANE_INLINE void zero_immovable_inertia(BodyLanes<M, V>& body) {
   }
 }
 
+template <class V>
+COLLIDE_LANE_INLINE Vec3<typename AccurateLanes<V>::type> widen(const Vec3<V>& v) {
+  using A = AccurateLanes<V>;
+  return {A::widen(v.x), A::widen(v.y), A::widen(v.z)};
+}
+template <class V, class W>
+COLLIDE_LANE_INLINE Vec3<V> narrow(const Vec3<W>& w) {
+  using A = AccurateLanes<V>;
+  return {A::narrow(w.x), A::narrow(w.y), A::narrow(w.z)};
+}
+
+/// The rotation of q / |q|, as the law defines it: q is normalised here
+/// (s = 2 / |q|^2), where the fast mode trusts the stored q to be unit.
+template <class W>
+COLLIDE_LANE_INLINE Mat3<W> normalised_rotation(const QuatLanes<W>& q) {
+  return rotation(q.w, q.x, q.y, q.z, W(2) / (((q.w * q.w + q.x * q.x) + q.y * q.y) + q.z * q.z));
+}
+
+/// The rigid float kernel forms its lever arms h = R^T (r x d) in double
+/// lanes (fast mode; see lever_arm). Every other kernel works in its own lanes.
+template <class M, class V>
+inline constexpr bool kWideLeverArms =
+    std::conjunction_v<std::is_same<M, RigidModel>, std::is_same<typename V::value_type, float>>;
+
+/// h = R^T ((c - p) x d) of a rigid float body, evaluated in double lanes from
+/// the stored c, p, q and d and rounded once to float. R^T x is applied as the
+/// rotation by the conjugate of q, normalised as the law says:
+///     R^T x = x + s (q_v x (q_v x x) - q_w (q_v x x)),   s = 2 / |q|^2,
+/// which needs no matrix: computed from the float lanes at each use, it keeps
+/// no double-lane state alive across the kernel (a double-lane matrix per body
+/// cost 0.6x in throughput through register spills). In double lanes c - p
+/// and every product of two floats are exact and every other rounding is
+/// 2^-53, so h is the exact law's h rounded once to float
+/// (docs/collision-law.md, "The lever arms").
+template <class M, class V>
+COLLIDE_LANE_INLINE Vec3<V> wide_lever(const BodyLanes<M, V>& body, const Vec3<V>& c, const Vec3<V>& d) {
+  using A = AccurateLanes<V>;
+  using W = typename A::type;
+  const Vec3<W> x = cross(widen(c) - widen(body.p), widen(d));
+  const Vec3<W> qv{A::widen(body.q.x), A::widen(body.q.y), A::widen(body.q.z)};
+  const W qw = A::widen(body.q.w);
+  const W s = W(2) / (((qw * qw + qv.x * qv.x) + qv.y * qv.y) + qv.z * qv.z);
+  const Vec3<W> qx = cross(qv, x);
+  return narrow<V>(x + (cross(qv, qx) - qx * qw) * s);
+}
+
 /// Relative velocity of a's contact point with respect to b's.
 template <class M, class V>
 COLLIDE_LANE_INLINE Vec3<V> relative_velocity(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b, const Vec3<V>& ra,
@@ -142,17 +188,28 @@ struct LeverArm {
 };
 
 template <class M, class V>
-COLLIDE_LANE_INLINE LeverArm<V> lever_arm(const BodyLanes<M, V>& body, const Vec3<V>& r, const Vec3<V>& d) {
+COLLIDE_LANE_INLINE LeverArm<V> lever_arm(const BodyLanes<M, V>& body, const Vec3<V>& r, const Vec3<V>& d,
+                                          const Vec3<V>& c) {
   // Filled member by member: GCC 12 copied a braced {response, k} through
   // general-purpose registers, 8 bytes at a time (store-forwarding stalls).
   if constexpr (std::is_same_v<M, ParticleModel>) return {};
   LeverArm<V> arm;
   if constexpr (std::is_same_v<M, RigidModel>) {
-    const Vec3<V> h = to_body(body.rotation, cross(r, d));
+    // The float kernel's h in double lanes: a needle's tiny h along its axis
+    // meets its huge inverse moment, a normal near r leaves |h| << |r|.
+    Vec3<V> h;
+    if constexpr (kWideLeverArms<M, V>) {
+      (void)r;
+      h = wide_lever(body, c, d);
+    } else {
+      (void)c;
+      h = to_body(body.rotation, cross(r, d));
+    }
     const Vec3<V> response = hadamard(body.inv_inertia, h);
     arm.response = to_world(body.rotation, response);
     arm.k = dot(h, response);
   } else if constexpr (std::is_same_v<M, SphereModel>) {
+    (void)c;
     const Vec3<V> h = cross(r, d);
     arm.response = h * body.inv_inertia.x;
     arm.k = dot(h, arm.response);
@@ -250,8 +307,8 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
 
   const Vec3<V> u = relative_velocity(a, b, ra, rb);
   const V vn = dot(u, n);
-  const LeverArm<V> arm_a = lever_arm(a, ra, n);
-  const LeverArm<V> arm_b = lever_arm(b, rb, n);
+  const LeverArm<V> arm_a = lever_arm(a, ra, n, contact.c);
+  const LeverArm<V> arm_b = lever_arm(b, rb, n, contact.c);
   const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
 
   const auto approaching = (vn < V(0)) && (k_n > V(0));
@@ -271,8 +328,8 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
       // may still overflow to inf, and then jt = mu jn.
       const auto sliding = may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
       const Vec3<V> t = slide.unit * (V(1) / select(sliding, slide.scaled_length, V(1)));
-      const LeverArm<V> tarm_a = lever_arm(a, ra, t);
-      const LeverArm<V> tarm_b = lever_arm(b, rb, t);
+      const LeverArm<V> tarm_a = lever_arm(a, ra, t, contact.c);
+      const LeverArm<V> tarm_b = lever_arm(b, rb, t, contact.c);
       const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
       const V jt = select(sliding, lane_min(slide.speed / k_t, contact.mu * jn), V(0));
       apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
@@ -280,39 +337,6 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
     }
   }
   return result;
-}
-
-template <class V>
-COLLIDE_LANE_INLINE Vec3<typename AccurateLanes<V>::type> widen(const Vec3<V>& v) {
-  using A = AccurateLanes<V>;
-  return {A::widen(v.x), A::widen(v.y), A::widen(v.z)};
-}
-template <class V, class W>
-COLLIDE_LANE_INLINE Vec3<V> narrow(const Vec3<W>& w) {
-  using A = AccurateLanes<V>;
-  return {A::narrow(w.x), A::narrow(w.y), A::narrow(w.z)};
-}
-
-/// The rotation of q / |q|, as the law defines it: q is normalised here
-/// (s = 2 / |q|^2), where the fast mode trusts the stored q to be unit.
-template <class W>
-COLLIDE_LANE_INLINE Mat3<W> normalised_rotation(const QuatLanes<W>& q) {
-  const W one(1);
-  const W xx = q.x * q.x, yy = q.y * q.y, zz = q.z * q.z;
-  const W xy = q.x * q.y, xz = q.x * q.z, yz = q.y * q.z;
-  const W wx = q.w * q.x, wy = q.w * q.y, wz = q.w * q.z;
-  const W s = W(2) / (((q.w * q.w + xx) + yy) + zz);
-  Mat3<W> m;
-  m.r[0][0] = one - s * (yy + zz);
-  m.r[0][1] = s * (xy - wz);
-  m.r[0][2] = s * (xz + wy);
-  m.r[1][0] = s * (xy + wz);
-  m.r[1][1] = one - s * (xx + zz);
-  m.r[1][2] = s * (yz - wx);
-  m.r[2][0] = s * (xz - wy);
-  m.r[2][1] = s * (yz + wx);
-  m.r[2][2] = one - s * (xx + yy);
-  return m;
 }
 
 /// One side's bodies in the accurate mode's lanes (exact: widening).

@@ -244,23 +244,26 @@ struct Mat3 {
   V r[3][3];
 };
 
-/// The rotation of a unit quaternion (w, x, y, z).
+/// The rotation of the quaternion (w, x, y, z) with s = 2 / |q|^2: s = 2
+/// (the default) trusts q to be unit, as the fast mode does with the stored
+/// q; the accurate mode and the rigid float kernel's lever arms pass
+/// 2 / |q|^2, which normalises q as the law says (contact_kernel.hpp).
 template <class V>
-COLLIDE_LANE_INLINE Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z) {
-  const V two(2), one(1);
+COLLIDE_LANE_INLINE Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z, const V& s = V(2)) {
+  const V one(1);
   const V xx = x * x, yy = y * y, zz = z * z;
   const V xy = x * y, xz = x * z, yz = y * z;
   const V wx = w * x, wy = w * y, wz = w * z;
   Mat3<V> m;
-  m.r[0][0] = one - two * (yy + zz);
-  m.r[0][1] = two * (xy - wz);
-  m.r[0][2] = two * (xz + wy);
-  m.r[1][0] = two * (xy + wz);
-  m.r[1][1] = one - two * (xx + zz);
-  m.r[1][2] = two * (yz - wx);
-  m.r[2][0] = two * (xz - wy);
-  m.r[2][1] = two * (yz + wx);
-  m.r[2][2] = one - two * (xx + yy);
+  m.r[0][0] = one - s * (yy + zz);
+  m.r[0][1] = s * (xy - wz);
+  m.r[0][2] = s * (xz + wy);
+  m.r[1][0] = s * (xy + wz);
+  m.r[1][1] = one - s * (xx + zz);
+  m.r[1][2] = s * (yz - wx);
+  m.r[2][0] = s * (xz - wy);
+  m.r[2][1] = s * (yz + wx);
+  m.r[2][2] = one - s * (xx + yy);
   return m;
 }
 

@@ -8,7 +8,9 @@
 //   n      the stored normal taken as unit (the law normalises it)
 //   u      relative velocity (va + wa x ra) - (vb + wb x rb), ra = c - pa
 //   vn     u . n
-//   lever  h = R^T (r x n) with R formed from the stored q, invI o h, h . invI o h
+//   lever  h = R^T (r x n) as the kernel forms it (float: in double from q
+//          normalised, then rounded; double: R from the stored q), invI o h,
+//          h . invI o h
 //   K      1/ma + 1/mb + ka + kb
 //   div    jn = -((1 + e) vn) / K, and J = jn n
 //   apply  v += n jn / m, w += R (invI o h) jn
@@ -26,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "collide/error_bound.hpp"
@@ -125,6 +128,25 @@ V3<X> to_world(const Rot<X>& m, V3<X> v) {
           m.r[2][0] * v.x + m.r[2][1] * v.y + m.r[2][2] * v.z};
 }
 
+/// h = R^T (r x d) as the fast kernel forms it from the stored values: the
+/// rigid float kernel in double lanes, from q normalised, rounded once to
+/// float (contact_kernel.hpp, wide_lever); the double kernel in double with
+/// R from q taken as unit.
+template <class T>
+V3<T> kernel_lever(const Body& x, V3<Q> c, V3<Q> d) {
+  if constexpr (std::is_same_v<T, float>) {
+    const V3<double> r = as<double>(as<T>(c)) - as<double>(as<T>(x.p));
+    const V3<double> xd = cross(r, as<double>(as<T>(d)));
+    const double qw = static_cast<T>(x.q[0]);
+    const V3<double> qv{static_cast<T>(x.q[1]), static_cast<T>(x.q[2]), static_cast<T>(x.q[3])};
+    const double s = 2.0 / (((qw * qw + qv.x * qv.x) + qv.y * qv.y) + qv.z * qv.z);
+    const V3<double> qx = cross(qv, xd);
+    return as<T>(xd + (cross(qv, qx) - qx * qw) * s);
+  } else {
+    return to_body(rotation_of<T>(x.q, false), cross(as<T>(c) - as<T>(x.p), as<T>(d)));
+  }
+}
+
 /// The law on one contact with term `in_t` evaluated in T (kTerms: none;
 /// -1: all). Returns J in Q.
 template <class T>
@@ -148,7 +170,7 @@ V3<Q> law(Body a, Body b, V3<Q> c, V3<Q> n_stored, Q e, Q mu, int in_t) {
     if (x.inv_mass == 0) return Arm{{0, 0, 0}, 0};
     if (in_T) {
       const Rot<T> R = rotation_of<T>(x.q, false);
-      const V3<T> h = to_body(R, cross(as<T>(c) - as<T>(x.p), as<T>(d)));
+      const V3<T> h = kernel_lever<T>(x, c, d);
       const V3<T> resp = had(as<T>(x.inv_i), h);
       return Arm{as<Q>(to_world(R, resp)), static_cast<Q>(dot(h, resp))};
     }

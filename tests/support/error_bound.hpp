@@ -8,14 +8,17 @@
 #pragma once
 
 #if __has_include("collide/error_bound.hpp")
+#include "collide/check.hpp"
 #include "collide/error_bound.hpp"
 namespace collide::test {
 inline constexpr long double kErrorBoundEps = static_cast<long double>(collide::kImpulseErrorBoundEps);
+inline constexpr long double kErrorTargetEps = static_cast<long double>(collide::kImpulseErrorTargetEps);
 }  // namespace collide::test
 #else
 namespace collide::test {
 // TODO(tests): drop this fallback once collide/error_bound.hpp
 // (collide::kImpulseErrorBoundEps) is in the library.
 inline constexpr long double kErrorBoundEps = 64;
+inline constexpr long double kErrorTargetEps = 2;
 }  // namespace collide::test
 #endif

@@ -47,7 +47,9 @@ struct ReferenceContact {
   /// for every contact with a movable body (approaching or not), plus, when
   /// friction acts,
   ///   (speed_scale + speed_scale') / K(t) * (1 + |W t| / K(t)),
-  /// where speed_scale' is taken after the normal impulse and W is the
+  /// where speed_scale' is taken after the normal impulse, plus the
+  /// uncertainty that impulse leaves in u', s_n |W n| + jn (max(1/Ia) |ra|^2
+  /// + max(1/Ib) |rb|^2) with s_n the normal part of the scale, and W is the
   /// contact's compliance (K(d) = d . W d): the friction direction t is a
   /// rounded velocity direction, and K(t) moves with it by up to that factor.
   /// |J| <= impulse_scale for the normal part, and a kernel error of a few
