@@ -6,7 +6,7 @@
 // law: the batches run one after another with blocks of 1024 contacts over
 // TBB, each contact is read through the schedule's order with its two
 // records and its own lines prefetched the same distance ahead, every value
-// of both records and of the contact is read, v (and w) of the movable
+// of both records (as 16-byte rows) and of the contact is read, v (and w) of the movable
 // bodies and J are written (one add of a multiple of zero per value instead
 // of the law). Kernel throughput over twin throughput is the fraction of the
 // layout's own ceiling that the arithmetic leaves.
@@ -22,16 +22,8 @@
 
 namespace collide_bench {
 
-/// Values of a record the kernel reads (all of them, from offset 0) and
-/// writes (v, and w where the model rotates): collide/packed.hpp.
-template <class Record>
-inline constexpr std::size_t kRecordValues = 0;
-template <class T>
-inline constexpr std::size_t kRecordValues<collide::PackedRigid<T>> = 17;
-template <class T>
-inline constexpr std::size_t kRecordValues<collide::PackedSphere<T>> = 11;
-template <class T>
-inline constexpr std::size_t kRecordValues<collide::PackedParticle<T>> = 4;
+/// Values of a record the kernel writes: v, and w where the model rotates
+/// (collide/packed.hpp).
 template <class Record>
 inline constexpr std::size_t kWrittenValues = 6;
 template <class T>
