@@ -426,6 +426,21 @@ void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model
                  collide::to_string(stats.isa) + ", " + std::to_string(stats.lanes) + " lanes");
 }
 
+/// f(Record{}) with the packed record type of `model`: the one place the
+/// layout and twin rows turn a model into a record type.
+template <class T, class F>
+auto with_record(collide::Model model, F&& f) {
+  switch (model) {
+    case collide::Model::particle:
+      return f(collide::PackedParticle<T>{});
+    case collide::Model::sphere:
+      return f(collide::PackedSphere<T>{});
+    case collide::Model::rigid:
+      break;
+  }
+  return f(collide::PackedRigid<T>{});
+}
+
 /// The bench's rigid bodies packed into records of a model (they fit it:
 /// Prepared scenes are generated for the model).
 template <class T, class Record>
@@ -469,18 +484,8 @@ void layout_row(benchmark::State& state, Kind kind, std::size_t n, collide::Mode
   options.layout = layout == LayoutRow::soa ? collide::BodyLayout::soa : collide::BodyLayout::packed;
   const collide::Solver solver(options);
   collide::SolveStats stats;
-  double seconds = 0;
-  switch (model) {
-    case collide::Model::particle:
-      seconds = layout_solve<T, collide::PackedParticle<T>>(state, p, solver, model, layout, stats);
-      break;
-    case collide::Model::sphere:
-      seconds = layout_solve<T, collide::PackedSphere<T>>(state, p, solver, model, layout, stats);
-      break;
-    case collide::Model::rigid:
-      seconds = layout_solve<T, collide::PackedRigid<T>>(state, p, solver, model, layout, stats);
-      break;
-  }
+  const double seconds = with_record<T>(
+      model, [&](auto record) { return layout_solve<T, decltype(record)>(state, p, solver, model, layout, stats); });
   Columns columns;
   columns.items = static_cast<double>(n);
   columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(model, sizeof(T), p.friction));
@@ -531,18 +536,8 @@ double packed_twin_solves(benchmark::State& state, Prepared<T>& p, int threads) 
 template <class T>
 void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, int threads) {
   Prepared<T>& p = g_cache.get<T>(kind, n, model, false);
-  double seconds = 0;
-  switch (model) {
-    case collide::Model::particle:
-      seconds = packed_twin_solves<T, collide::PackedParticle<T>>(state, p, threads);
-      break;
-    case collide::Model::sphere:
-      seconds = packed_twin_solves<T, collide::PackedSphere<T>>(state, p, threads);
-      break;
-    case collide::Model::rigid:
-      seconds = packed_twin_solves<T, collide::PackedRigid<T>>(state, p, threads);
-      break;
-  }
+  const double seconds =
+      with_record<T>(model, [&](auto record) { return packed_twin_solves<T, decltype(record)>(state, p, threads); });
   Columns columns;
   columns.items = static_cast<double>(n);
   columns.bytes_per_item = static_cast<double>(collide::bytes_per_collision(model, sizeof(T), false));
