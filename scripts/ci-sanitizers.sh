@@ -33,12 +33,19 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 jobs="$(nproc)"
 fuzz_seconds="${FUZZ_SECONDS:-60}"
 cxx="$(command -v clang++-14 || command -v clang++)"
+# Through ccache when present, as scripts/build.sh does: a re-run after a
+# change recompiles only what changed.
+launcher=()
+if command -v ccache >/dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
+fi
 stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
 
 # --- 1. ASan + UBSan --------------------------------------------------------
 asan="$root/build-asan"
 stage "ASan+UBSan build"
-cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
+cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" \
   -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$asan" -j"$jobs"
@@ -75,7 +82,7 @@ done
 # --- 3. TSan on the parallel kernel -------------------------------------------
 tsan="$root/build-tsan"
 stage "TSan build"
-cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DCOLLIDE_SANITIZE=thread \
+cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" -DCOLLIDE_SANITIZE=thread \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_solver_arena test_hard_shared \
   collide_itt_tsan collide_race_canary

@@ -11,6 +11,7 @@
 #include <collide/contacts.hpp>
 #include <collide/error_bound.hpp>
 #include <collide/generate.hpp>
+#include <collide/isa.hpp>
 #include <collide/model.hpp>
 #include <collide/reference.hpp>
 #include <collide/scene.hpp>
@@ -113,9 +114,20 @@ void solve_owned_buffers() {
 
 }  // namespace
 
+// A library built with COLLIDE_KERNEL_ISAS=sse2 has no wider kernel to offer,
+// whatever the CPU has, and still solves (above) on its baseline lanes.
+void check_kernels_built() {
+#if defined(COLLIDE_CONSUMER_BASELINE_ONLY)
+  expect(collide::best_isa() == collide::Isa::sse2, "COLLIDE_KERNEL_ISAS=sse2: best_isa() is sse2");
+  expect(!collide::isa_supported(collide::Isa::avx2), "COLLIDE_KERNEL_ISAS=sse2: no AVX2 kernel");
+  std::puts("consumer: baseline kernel only, as configured");
+#endif
+}
+
 int main() {
   solve_caller_arrays();
   solve_owned_buffers();
+  check_kernels_built();
   if (failures != 0) return 1;
   std::puts("consumer: ok");
   return 0;
