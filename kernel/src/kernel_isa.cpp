@@ -213,18 +213,22 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
 /// On the packed layout, the records of the contacts kPrefetchAhead
 /// positions ahead are requested before each group: a record is one to three
 /// lines, so the requests are few and the misses overlap instead of waiting
-/// one after another. In a scattered batch the contact's own lines are
-/// requested too. That replaced copying the contacts into schedule order
-/// before the solve (and J back after): measured alternately in one process
-/// (debris, rigid, float, AVX-512, 2 threads), the copy was no faster at 4M
-/// contacts, 20-30% slower at 1M, 5% faster in cache at 64k, and cost 56
-/// bytes per contact of scratch.
+/// one after another. In a scattered batch the contact's own lines (its body
+/// indices, fields and J) are requested twice as far ahead: the record
+/// requests read the body indices, which would otherwise be a demand miss
+/// of their own and stall the loop at every contact. That replaced copying
+/// the contacts into schedule order before the solve (and J back after):
+/// measured alternately in one process (debris, rigid, float, AVX-512, 2
+/// threads), the copy was no faster at 4M contacts, 20-30% slower at 1M, 5%
+/// faster in cache at 64k, and cost 56 bytes per contact of scratch.
 inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
 
 /// Asks for the lines of contact k's fields and of its J: a scattered batch
 /// reads them from lines that hold few other contacts of the batch.
 template <class T>
 COLLIDE_LANE_INLINE void prefetch_contact(const ContactView<T>& c, const ImpulseView<T>& j, std::uint32_t k) {
+  __builtin_prefetch(c.a + k, 0, 2);
+  __builtin_prefetch(c.b + k, 0, 2);
   for (const T* f : {c.c.x, c.c.y, c.c.z, c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
   if (c.e != nullptr) __builtin_prefetch(c.e + k, 0, 2);
   if (c.mu != nullptr) __builtin_prefetch(c.mu + k, 0, 2);
@@ -239,17 +243,24 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
   std::size_t i = begin;
   if constexpr (!kSoaLayout<View>) {
     if (W > 1) {
-      const std::size_t warm = std::min(end, begin + kPrefetchAhead);
-      for (std::size_t k = begin; k < warm; ++k) {
+      if (!contiguous) {
+        for (std::size_t k = begin; k < std::min(end, begin + 2 * kPrefetchAhead); ++k) {
+          prefetch_contact(contacts, impulses, order[k]);
+        }
+      }
+      for (std::size_t k = begin; k < std::min(end, begin + kPrefetchAhead); ++k) {
         prefetch_record(bodies.bodies, contacts.a[order[k]]);
         prefetch_record(bodies.bodies, contacts.b[order[k]]);
       }
       for (; i + W <= end; i += W) {
-        const std::size_t ahead_end = std::min(end, i + W + kPrefetchAhead);
-        for (std::size_t k = i + kPrefetchAhead; k < ahead_end; ++k) {
+        if (!contiguous) {
+          for (std::size_t k = i + 2 * kPrefetchAhead; k < std::min(end, i + W + 2 * kPrefetchAhead); ++k) {
+            prefetch_contact(contacts, impulses, order[k]);
+          }
+        }
+        for (std::size_t k = i + kPrefetchAhead; k < std::min(end, i + W + kPrefetchAhead); ++k) {
           prefetch_record(bodies.bodies, contacts.a[order[k]]);
           prefetch_record(bodies.bodies, contacts.b[order[k]]);
-          if (!contiguous) prefetch_contact(contacts, impulses, order[k]);
         }
         solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses,
                                               ContactGroup{contiguous, order[i], order + i});

@@ -161,15 +161,29 @@ COLLIDE_LANE_INLINE void transpose_rows(const typename V::value_type* const* row
   for (std::size_t k = 0; k < W; ++k) out[k] = V([&](auto lane) { return rows[lane][offset + k]; });
 }
 
+/// How many W x W transposes load_record_values does for N values of a
+/// record of S: one per block of W values that fits in the record, except a
+/// last block with W/4 values or fewer, which is cheaper lane by lane (a
+/// transpose is W loads and about W log2 W shuffles, the lane-by-lane fill W
+/// loads and inserts per value). Rigid float at 16 lanes: 17 values, one
+/// transpose and value 16 by lanes, not a second transpose for one value.
+template <std::size_t W, std::size_t N, std::size_t S>
+inline constexpr std::size_t kRecordTransposes = [] {
+  if (W <= 1) return std::size_t{0};
+  const std::size_t whole = std::min(S / W, N / W);
+  const std::size_t rest = N - whole * W;
+  const bool last = rest > W / 4 && (whole + 1) * W <= S;
+  return whole + (last ? 1 : 0);
+}();
+
 /// out[k] lane l = records[idx[l]].value k, for the first N values of records
-/// of S values each: whole transposes while W values fit in the record, the
-/// rest lane by lane.
+/// of S values each: transposes (kRecordTransposes), the rest lane by lane.
 template <class V, std::size_t N, std::size_t S, class Index>
 COLLIDE_LANE_INLINE void load_record_values(const typename V::value_type* records, const Index* idx, V* out) {
   constexpr std::size_t W = V::size();
   const typename V::value_type* rows[W];
   for (std::size_t l = 0; l < W; ++l) rows[l] = records + static_cast<std::size_t>(idx[l]) * S;
-  constexpr std::size_t kTransposes = W > 1 ? std::min(S / W, (N + W - 1) / W) : 0;
+  constexpr std::size_t kTransposes = kRecordTransposes<W, N, S>;
   for (std::size_t t = 0; t < kTransposes; ++t) {
     V block[W];
     transpose_rows<V>(rows, t * W, block);
