@@ -148,8 +148,7 @@ std::size_t simd_lanes(const KernelTable& table) {
 /// Walks the batches of the schedule; blocks of a large batch run in parallel.
 template <class T>
 SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb::task_arena& arena,
-                        const KernelJob<T>& job, std::size_t body_count, const Schedule& schedule,
-                        bool in_schedule_order = false) {
+                        const KernelJob<T>& job, std::size_t body_count, const Schedule& schedule) {
   assert(schedule.contact_count() == job.contacts.count);
   assert(schedule.body_count() == body_count);
   assert(job.impulses.count == job.contacts.count);
@@ -164,9 +163,7 @@ SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb:
     for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
       const std::size_t begin = schedule.batch_begin(k);
       const std::size_t end = schedule.batch_begin(k + 1);
-      // Contacts copied into schedule order (OrderedContacts) make every
-      // batch a consecutive range of the copy.
-      const bool contiguous = in_schedule_order || schedule.batch_is_contiguous(k);
+      const bool contiguous = schedule.batch_is_contiguous(k);
       const std::size_t n = end - begin;
       if (n < 2 * block || arena.max_concurrency() == 1) {
         kernel(job, contiguous, begin, end);
