@@ -44,7 +44,7 @@ const char* const kReportUsage =
     "                  needles, levers, grazing, unit scales, subnormals, resting,\n"
     "                  e = 0 and 1, stick/slip, spin, cradles, stars, a cluster) in\n"
     "                  float and double, fast and accurate mode: speed, error in\n"
-    "                  eps x impulse scale and in ulps (about a minute)\n"
+    "                  eps x impulse scale and in ulps (takes seconds)\n"
     "  --hard-n N      pairs of each hard pair family (default 1000)\n"
     "\n"
     "exit codes: 0 success, 1 I/O error or gnuplot missing with --plot, 2 usage\n"
