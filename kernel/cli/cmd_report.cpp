@@ -160,6 +160,7 @@ int run_report(int argc, char** argv) {
     }
   }
   for (const HardRow& row : report.hard) {
+    if (row.judge == "none") continue;  // no reference that can judge it in this build
     const bool accurate = row.mode == "accurate";
     const double figure = accurate ? row.max_err_ulps : row.max_err_eps;
     const double bound = accurate ? kAccurateErrorUlps : kImpulseErrorBoundEps;

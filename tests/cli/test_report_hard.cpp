@@ -29,6 +29,7 @@
 #include "collide/check.hpp"
 #include "collide/hard_scenes.hpp"
 #include "collide/model.hpp"
+#include "collide/reference.hpp"  // COLLIDE_HAS_FLOAT128
 #include "support/mini_json.hpp"
 #include "support/run_cli.hpp"
 
@@ -140,8 +141,15 @@ TEST_F(HardReportRun, FastRowsWithinTheTargetAccurateRowsWithinTheirUlps) {
     SCOPED_TRACE(trace(row));
     // Missing (null) figures fail: a JSON null leaves the kind at null.
     ASSERT_EQ(row.at("max_err_eps").kind, Json::number);
-    ASSERT_EQ(row.at("max_err_ulps").kind, Json::number);
     EXPECT_LE(row.at("max_err_eps").num, collide::kImpulseErrorTargetEps);
+    // Double's ulps need the __float128 reference (GCC on x86-64); a build
+    // without it says so and leaves the figure out.
+    if (row.at("judge").str == "none") {
+      EXPECT_EQ(row.at("precision").str, "double");
+      EXPECT_EQ(row.at("max_err_ulps").kind, Json::null);
+      continue;
+    }
+    ASSERT_EQ(row.at("max_err_ulps").kind, Json::number);
     if (row.at("mode").str == "accurate") {
       EXPECT_LE(row.at("max_err_ulps").num, collide::kAccurateErrorUlps);
       ++accurate;
@@ -151,6 +159,9 @@ TEST_F(HardReportRun, FastRowsWithinTheTargetAccurateRowsWithinTheirUlps) {
   }
   EXPECT_EQ(fast, accurate);
   EXPECT_GT(fast, 0U);
+#if COLLIDE_HAS_FLOAT128
+  for (const Json& row : hard()) EXPECT_NE(row.at("judge").str, "none") << trace(row);
+#endif
 }
 
 TEST_F(HardReportRun, GrazingShowsWhyTheAccurateModeExists) {
@@ -164,12 +175,13 @@ TEST_F(HardReportRun, GrazingShowsWhyTheAccurateModeExists) {
   for (const Json& row : hard()) {
     if (row.at("family").str != "grazing" || row.at("mode").str != "fast") continue;
     SCOPED_TRACE(trace(row));
+    ++checked;
+    if (row.at("judge").str == "none") continue;  // no __float128 in this build
     if (row.at("model").str == "particle") {
       EXPECT_LE(row.at("max_err_ulps").num, collide::kAccurateErrorUlps);
     } else {
       EXPECT_GT(row.at("max_err_ulps").num, 1000 * collide::kAccurateErrorUlps);
     }
-    ++checked;
   }
   EXPECT_EQ(checked, 3U * 2U);  // models x precisions
 }

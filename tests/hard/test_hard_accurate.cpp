@@ -103,23 +103,6 @@ SolverOptions accurate_options(Path path, int threads = 1, std::size_t block = 4
   return o;
 }
 
-/// Contact k of a view, as a view of one contact (no copy, no renormalising).
-template <class T>
-ContactView<T> one_contact(ContactView<T> v, std::size_t k) {
-  v.count = 1;
-  v.a += k;
-  v.b += k;
-  v.c.x += k;
-  v.c.y += k;
-  v.c.z += k;
-  v.n.x += k;
-  v.n.y += k;
-  v.n.z += k;
-  if (v.e) v.e += k;
-  if (v.mu) v.mu += k;
-  return v;
-}
-
 /// Shared-body scenes: each contact against the exact law applied to the
 /// velocities as stored before it. The bodies' state between contacts is
 /// stored in T (the law is applied contact by contact to stored velocities),
@@ -137,7 +120,7 @@ UlpStats<T> chain_ulp_errors(const Scene<T>& scene, Model model, const Outcome<T
   const Solver solver(accurate_options<T>(Path::scalar));
   const ContactView<T> all = scene.contacts.view();
   for (std::size_t k = 0; k < all.count; ++k) {
-    const ContactView<T> one = one_contact(all, k);
+    const ContactView<T> one = contact_slice(all, k, 1);
     BodyBuffer<S> ref_bodies = convert_bodies<S>(std::as_const(state).view());
     const ContactBuffer<S> ref_contact = convert_contacts<S>(one);
     const ImpulseBuffer<S> ref = test::reference(ref_bodies, ref_contact.view());

@@ -2,8 +2,9 @@
 // the kernel tests.
 //
 // The tests do not depend on the library's generator (generate.cpp): every
-// scene here is drawn with std::mt19937_64 from a seed and pushed through the
-// public BodyBuffer / ContactBuffer API, so a test failure can always be
+// scene here is drawn with std::mt19937_64 from a seed (the draws of
+// collide/hard_scenes.hpp, which the hard families share) and pushed through
+// the public BodyBuffer / ContactBuffer API, so a test failure can always be
 // reproduced from the seed printed with it.
 //
 // Two shapes of scene:

@@ -85,7 +85,10 @@ struct HardRow {
   /// Shared scenes: each contact against the law applied to the velocities
   /// as stored before it, which the mode's own solve leaves.
   double max_err_ulps = 0;
-  std::string judge;  ///< precision of the reference for max_err_ulps: "long double" or "__float128"
+  /// Precision of the reference for max_err_ulps: "long double" (float),
+  /// "__float128" (double), or "none" for double in a build without
+  /// __float128, where max_err_ulps is NaN (not measured).
+  std::string judge;
 };
 
 /// One point of the throughput-against-N sweep (pairs scene, SIMD, float).

@@ -202,9 +202,10 @@ std::string format_report_table(const Report& report) {
     for (const HardRow& h : report.hard) {
       if (!previous.empty() && h.family != previous) out += "\n";
       previous = h.family;
-      std::snprintf(line, sizeof line, "%-18s %-8s %-9s %-8s %-6s %6zu %6zu %8.2f %9.3g %9.3g %12.4g\n",
-                    h.family.c_str(), h.model.c_str(), h.precision.c_str(), h.mode.c_str(), h.isa.c_str(), h.n,
-                    h.acting, h.collisions_per_second / 1e6, h.max_err_eps, h.p99_err_eps, h.max_err_ulps);
+      const std::string ulps = std::isnan(h.max_err_ulps) ? "n/a" : format("%.4g", h.max_err_ulps);
+      std::snprintf(line, sizeof line, "%-18s %-8s %-9s %-8s %-6s %6zu %6zu %8.2f %9.3g %9.3g %12s\n", h.family.c_str(),
+                    h.model.c_str(), h.precision.c_str(), h.mode.c_str(), h.isa.c_str(), h.n, h.acting,
+                    h.collisions_per_second / 1e6, h.max_err_eps, h.p99_err_eps, ulps.c_str());
       out += line;
     }
   }
