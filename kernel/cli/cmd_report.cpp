@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "collide/check.hpp"
 #include "collide/error_bound.hpp"
 #include "collide/report.hpp"
 #include "collide/scene_io.hpp"
@@ -18,6 +19,7 @@ namespace collide::cli {
 const char* const kReportUsage =
     "usage: collide report [--n N] [--debris-n N] [--threads LIST] [--json FILE]\n"
     "                      [--plot FILE.png] [--sample N] [--runs R] [--seed S] [--quick]\n"
+    "                      [--hard] [--hard-n N]\n"
     "\n"
     "Measures every variant of the solver on the pairs scene and the debris scene:\n"
     "speed (collisions per second, median of R timed runs, and the fraction of the\n"
@@ -38,9 +40,16 @@ const char* const kReportUsage =
     "  --seed S        scene seed (default 1)\n"
     "  --quick         a smoke run for tests: 3 runs, a sample of at most N, a short\n"
     "                  sweep, a short triad\n"
+    "  --hard          also measure the hard scenes (mass ratios, immovable bodies,\n"
+    "                  needles, levers, grazing, unit scales, subnormals, resting,\n"
+    "                  e = 0 and 1, stick/slip, spin, cradles, stars, a cluster) in\n"
+    "                  float and double, fast and accurate mode: speed, error in\n"
+    "                  eps x impulse scale and in ulps (takes seconds)\n"
+    "  --hard-n N      pairs of each hard pair family (default 1000)\n"
     "\n"
     "exit codes: 0 success, 1 I/O error or gnuplot missing with --plot, 2 usage\n"
-    "            error, 3 a kernel variant's error exceeds the documented bound\n";
+    "            error, 3 a kernel variant's error exceeds the documented bound\n"
+    "            (--hard: also an accurate row above its bound in ulps)\n";
 
 namespace {
 std::vector<int> parse_thread_list(const std::string& text) {
@@ -80,7 +89,9 @@ int run_report(int argc, char** argv) {
                                      {"sample", true},
                                      {"runs", true},
                                      {"seed", true},
-                                     {"quick", false}});
+                                     {"quick", false},
+                                     {"hard", false},
+                                     {"hard-n", true}});
   if (opt.count("help") != 0) {
     std::fputs(kReportUsage, stdout);
     return kExitOk;
@@ -112,6 +123,11 @@ int run_report(int argc, char** argv) {
   } else {
     config.debris_n = std::min(config.n, config.debris_n);
   }
+  config.hard = opt.count("hard") != 0 || opt.count("hard-n") != 0;
+  if (const auto it = opt.find("hard-n"); it != opt.end()) {
+    config.hard_n = parse_count("hard-n", it->second);
+    if (config.hard_n < 1 || config.hard_n > 0x7FFFFFFFULL) throw UsageError("--hard-n must be from 1 to 2^31 - 1");
+  }
   if (!plot_path.empty()) {
     // Few points, so the sweep fits the budget: the two scenes of millions of
     // pairs dominate its time (3 runs each).
@@ -140,6 +156,18 @@ int run_report(int argc, char** argv) {
                    "bound of %g\n",
                    row.scene.c_str(), row.variant.c_str(), row.precision.c_str(), row.model.c_str(), row.max_err_eps,
                    kImpulseErrorBoundEps);
+      status = kExitCheckFailed;
+    }
+  }
+  for (const HardRow& row : report.hard) {
+    if (row.judge == "none") continue;  // no reference that can judge it in this build
+    const bool accurate = row.mode == "accurate";
+    const double figure = accurate ? row.max_err_ulps : row.max_err_eps;
+    const double bound = accurate ? kAccurateErrorUlps : kImpulseErrorBoundEps;
+    if (!(figure <= bound)) {
+      std::fprintf(stderr, "collide report: hard %s %s %s %s: error %.6g %s exceeds the documented bound of %g\n",
+                   row.family.c_str(), row.model.c_str(), row.precision.c_str(), row.mode.c_str(), figure,
+                   accurate ? "ulps" : "eps * impulse_scale", bound);
       status = kExitCheckFailed;
     }
   }

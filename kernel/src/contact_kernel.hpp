@@ -289,10 +289,140 @@ COLLIDE_LANE_INLINE SlidingDirection<V> sliding_direction(const Vec3<V>& ut) {
   return d;
 }
 
+/// The normal impulse of W contacts: which lanes act (approaching, K(n) > 0)
+/// and jn there (0 elsewhere).
+template <class V>
+struct NormalImpulse {
+  typename V::mask_type approaching;
+  V jn;
+};
+
+/// |n|^2 - 1 of a stored double normal, to about eps^2 (not eps): each
+/// n_i^2 = p_i + e_i exactly (TwoProduct), the p_i summed with TwoSum and 1
+/// subtracted from the sum, exactly for any n within 1/sqrt(2) .. sqrt(2) of
+/// unit length (Sterbenz), which validate() and the CSV reader guarantee.
+template <class V>
+COLLIDE_LANE_INLINE V norm_excess(const Vec3<V>& n) {
+  V px, ex, py, ey, pz, ez, s, t1, t2;
+  two_product(n.x, n.x, px, ex);
+  two_product(n.y, n.y, py, ey);
+  two_product(n.z, n.z, pz, ez);
+  two_sum(px, py, s, t1);
+  two_sum(s, pz, s, t2);
+  return (s - V(1)) + (((ex + ey) + ez) + (t1 + t2));
+}
+
+/// u . n of a particle contact (u = va - vb) in double, as hi + lo to about
+/// eps^2 |u|: u_i = uh_i + ul_i exactly (TwoSum), uh_i n_i = p_i + e_i
+/// exactly (TwoProduct), the p_i summed with TwoSum, and the small parts
+/// (products, TwoSum errors, ul . n) added in plain double, then
+/// renormalised, so hi carries the sign of the exact vn (Ogita, Rump and
+/// Oishi's Dot2 on the six-term sum).
+template <class V>
+COLLIDE_LANE_INLINE void compensated_particle_vn(const Vec3<V>& va, const Vec3<V>& vb, const Vec3<V>& n, V& hi, V& lo) {
+  V uhx, ulx, uhy, uly, uhz, ulz;
+  two_sum(va.x, -vb.x, uhx, ulx);
+  two_sum(va.y, -vb.y, uhy, uly);
+  two_sum(va.z, -vb.z, uhz, ulz);
+  V px, ex, py, ey, pz, ez, s, t1, t2;
+  two_product(uhx, n.x, px, ex);
+  two_product(uhy, n.y, py, ey);
+  two_product(uhz, n.z, pz, ez);
+  two_sum(px, py, s, t1);
+  two_sum(s, pz, s, t2);
+  const V small = (((ex + ey) + ez) + (t1 + t2)) + ((ulx * n.x + uly * n.y) + ulz * n.z);
+  two_sum(s, small, hi, lo);
+}
+
+/// -(1 + e) (vh + vl) / (kh + kl), rounded once (to about eps^2 before
+/// it): (1 + e) vh is formed exactly (FastTwoSum, TwoProduct), and the
+/// quotient q1 = N * (1/kh) is corrected by the remainder N - q1 K, which
+/// TwoProduct forms exactly, times 1/kh (one division in all). Lanes with
+/// kh = 0 give inf or NaN, which the caller discards.
+template <class V>
+COLLIDE_LANE_INLINE V compensated_normal_impulse(const V& vh, const V& vl, const V& e, const V& kh, const V& kl) {
+  V oh, ol, p, pe, ph, phe;
+  fast_two_sum(V(1), e, oh, ol);  // 1 >= e >= 0
+  two_product(oh, vh, p, pe);
+  const V n_lo = pe + (oh * vl + ol * vh);
+  const V inv = V(1) / kh;
+  const V q1 = p * inv;
+  two_product(q1, kh, ph, phe);
+  const V r = (((p - ph) - phe) + n_lo) - q1 * kl;
+  return -(q1 + r * inv);
+}
+
+/// The normal impulse in the fast mode. The law normalises n; the stored n
+/// is unit only to a few eps, and the kernels take it as it is. The impulse
+/// P = jn n is then the law's when jn = -(1 + e) (u . n) / D with
+///     D = |n|^2 (1/ma + 1/mb) + ka(n) + kb(n)   (= |n|^2 K(n / |n|)),
+/// since the lever terms ka, kb, computed from the stored n, already carry
+/// |n|^2. Taking |n| = 1 instead scaled every impulse by |n|^2, up to 1.5
+/// eps-units on its own, and a chain of contacts along one normal (a
+/// Newton's cradle) passed the factor down every link
+/// (docs/collision-law.md, "The normal impulse in the fast mode").
+///   * float: |n|^2, the sum D and the quotient are formed in double lanes
+///     and jn rounded once; the particle model's u . n too (va - vb and
+///     its products with n are exact there);
+///   * double: |n|^2 - 1 to eps^2 (norm_excess) corrects D; the particle
+///     model forms u . n and the quotient compensated
+///     (compensated_particle_vn, compensated_normal_impulse), so that its
+///     jn is rounded once; the rigid and sphere models divide in double.
+/// The particle model was up to 2.8 eps-units on the report's scenes, a
+/// single contact's rounding (hard_attribution: the normal taken as unit,
+/// vn and the quotient, each up to 1.5 to 1.8 alone); it is now one
+/// rounding of jn and one of J = jn n (0.8).
+template <class M, class V>
+COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                                         const Vec3<V>& u, const Vec3<V>& n, const V& e,
+                                                         const LeverArm<V>& arm_a, const LeverArm<V>& arm_b) {
+  using T = typename V::value_type;
+  NormalImpulse<V> r;
+  const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
+  if constexpr (std::is_same_v<T, float>) {
+    using A = AccurateLanes<V>;
+    using W = typename A::type;
+    const Vec3<W> nw = widen(n);
+    W vn_w;
+    V vn;
+    if constexpr (kRotates<M>) {
+      vn = dot(u, n);
+      vn_w = A::widen(vn);
+    } else {
+      (void)u;
+      vn_w = dot(widen(a.v) - widen(b.v), nw);
+      vn = A::narrow(vn_w);  // keeps the sign; a vn that narrows to 0 has an impulse below the floor
+    }
+    W d = (A::widen(a.inv_mass) + A::widen(b.inv_mass)) * dot(nw, nw);
+    if constexpr (kRotates<M>) d = (d + A::widen(arm_a.k)) + A::widen(arm_b.k);
+    r.approaching = (vn < V(0)) && (k_n > V(0));
+    // Inactive lanes may divide by zero here; their result is discarded.
+    r.jn = select(r.approaching, A::narrow(-((W(1) + A::widen(e)) * vn_w) / d), V(0));
+  } else {
+    const V excess = norm_excess(n);
+    if constexpr (kRotates<M>) {
+      const V vn = dot(u, n);
+      const V d = k_n + (a.inv_mass + b.inv_mass) * excess;
+      r.approaching = (vn < V(0)) && (k_n > V(0));
+      r.jn = select(r.approaching, -((V(1) + e) * vn) / d, V(0));
+    } else {
+      (void)u;
+      V vh, vl, kh, kl;
+      compensated_particle_vn(a.v, b.v, n, vh, vl);
+      two_sum(a.inv_mass, b.inv_mass, kh, kl);
+      V dh, dl;
+      fast_two_sum(kh, kl + kh * excess, dh, dl);  // |kh| >= |kl + kh excess|
+      r.approaching = (vh < V(0)) && (k_n > V(0));
+      r.jn = select(r.approaching, compensated_normal_impulse(vh, vl, e, dh, dl), V(0));
+    }
+  }
+  return r;
+}
+
 /// The law for W contacts whose bodies are pairwise distinct (or immovable),
 /// evaluated in the lanes V. kFriction selects the Coulomb step; without it
 /// `mu` is never read.
-template <class M, class V, bool kFriction>
+template <class M, class V, bool kFriction, class Mode>
 COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                   const ContactLanes<V>& contact) {
   zero_immovable_inertia(a);
@@ -305,15 +435,24 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
     rb = contact.c - b.p;
   }
 
-  const Vec3<V> u = relative_velocity(a, b, ra, rb);
-  const V vn = dot(u, n);
+  Vec3<V> u{};
+  if constexpr (kRotates<M> || std::is_same_v<Mode, AccurateMode>) u = relative_velocity(a, b, ra, rb);
   const LeverArm<V> arm_a = lever_arm(a, ra, n, contact.c);
   const LeverArm<V> arm_b = lever_arm(b, rb, n, contact.c);
-  const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
 
-  const auto approaching = (vn < V(0)) && (k_n > V(0));
-  // Inactive lanes may divide by zero here; their result is discarded.
-  const V jn = select(approaching, -((V(1) + contact.e) * vn) / k_n, V(0));
+  NormalImpulse<V> normal;
+  if constexpr (std::is_same_v<Mode, FastMode>) {
+    normal = fast_normal_impulse(a, b, u, n, contact.e, arm_a, arm_b);
+  } else {
+    // The accurate mode's lanes carry n normalised and every digit needed.
+    const V vn = dot(u, n);
+    const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
+    normal.approaching = (vn < V(0)) && (k_n > V(0));
+    // Inactive lanes may divide by zero here; their result is discarded.
+    normal.jn = select(normal.approaching, -((V(1) + contact.e) * vn) / k_n, V(0));
+  }
+  const auto& approaching = normal.approaching;
+  const V& jn = normal.jn;
   apply_impulse(a, b, n, jn, arm_a, arm_b, approaching);
 
   ContactResult<V> result{n * jn};
@@ -382,7 +521,7 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law_accurately(BodyLanes<M, V>& a,
   wc.n = n * (W(1) / lane_sqrt(dot(n, n)));
   wc.e = A::widen(contact.e);
   if constexpr (kFriction) wc.mu = A::widen(contact.mu);
-  const ContactResult<W> r = evaluate_law<M, W, kFriction>(wa, wb, wc);
+  const ContactResult<W> r = evaluate_law<M, W, kFriction, AccurateMode>(wa, wb, wc);
   a.v = narrow<V>(wa.v);
   b.v = narrow<V>(wb.v);
   if constexpr (kRotates<M>) {
@@ -399,7 +538,7 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
   if constexpr (std::is_same_v<Mode, AccurateMode>) {
     return evaluate_law_accurately<M, V, kFriction>(a, b, contact);
   } else {
-    return evaluate_law<M, V, kFriction>(a, b, contact);
+    return evaluate_law<M, V, kFriction, FastMode>(a, b, contact);
   }
 }
 

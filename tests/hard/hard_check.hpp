@@ -32,16 +32,19 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/hard_scenes.hpp"
 #include "collide/model.hpp"
 #include "collide/reference.hpp"
 #include "collide/scene.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
-#include "hard/hard_families.hpp"
 #include "support/error_bound.hpp"
 #include "support/solve_helpers.hpp"
 
 namespace collide::hard {
+
+using L = long double;
+using V3 = std::array<double, 3>;
 
 /// The long double reference of a scene: solved bodies, impulses, and the
 /// per-contact diagnostics (impulse_scale, vn, jn, ...).
@@ -132,13 +135,13 @@ template <class T>
 }
 
 /// The models that fit a scene shaped for `fit`, cheapest first.
-inline std::vector<Model> models_for(Fit fit) {
+inline std::vector<Model> models_for(Model fit) {
   switch (fit) {
-    case Fit::particle:
+    case Model::particle:
       return {Model::particle, Model::sphere, Model::rigid};
-    case Fit::sphere:
+    case Model::sphere:
       return {Model::sphere, Model::rigid};
-    case Fit::rigid:
+    case Model::rigid:
       break;
   }
   return {Model::rigid};
@@ -168,12 +171,12 @@ inline void report(const std::string& family, const char* precision, Model model
 /// contacts must receive an impulse in the reference, so that a family that
 /// degenerated into nothing fails.
 template <class T>
-void run_scene(const std::string& family, const Scene<T>& scene, const BodyBuffer<T>& start, Fit fit,
+void run_scene(const std::string& family, const Scene<T>& scene, const BodyBuffer<T>& start, Model fit,
                std::size_t min_acting, const ExtraCheck<T>& extra = nullptr, L target = test::kErrorTargetEps) {
   const char* precision = test::type_name<T>();
   SCOPED_TRACE(family + " " + precision + " " + to_string(fit));
   BodyBuffer<T> probe = start;
-  ASSERT_EQ(choose_model(probe.view(), scene.contacts.view()), model_of(fit)) << "the scene is not shaped for its fit";
+  ASSERT_EQ(choose_model(probe.view(), scene.contacts.view()), fit) << "the scene is not shaped for its fit";
 
   Scene<T> ref_input{start, scene.contacts};
   const Reference ref = reference_of(ref_input);
@@ -198,7 +201,7 @@ void run_scene(const std::string& family, const Scene<T>& scene, const BodyBuffe
 }
 
 template <class T>
-void run_scene(const std::string& family, const Scene<T>& scene, Fit fit, std::size_t min_acting,
+void run_scene(const std::string& family, const Scene<T>& scene, Model fit, std::size_t min_acting,
                const ExtraCheck<T>& extra = nullptr, L target = test::kErrorTargetEps) {
   run_scene(family, scene, scene.bodies, fit, min_acting, extra, target);
 }

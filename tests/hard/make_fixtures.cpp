@@ -9,7 +9,7 @@
 // to them; rerun this only when a family or the law changes.
 //
 // Why the fixtures look the way they do:
-// * The scenes are the hard-case families of hard_families.hpp drawn in
+// * The scenes are the hard-case families of collide/hard_scenes.hpp drawn in
 //   float and written exactly (shortest round trip of the float value, read
 //   back as double it is the same number), so the file means the same scene
 //   to a float and a double run; only the normalisation of q and n, done in
@@ -29,16 +29,16 @@
 #include <utility>
 #include <vector>
 
+#include "collide/hard_scenes.hpp"
 #include "collide/reference.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
-#include "hard/hard_families.hpp"
 
 namespace {
 
-using collide::hard::Fit;
-using collide::hard::L;
-using collide::test::SceneRecords;
+using L = long double;
+using collide::Model;
+using collide::SceneRecords;
 
 struct Fixture {
   const char* name;
@@ -48,19 +48,19 @@ struct Fixture {
 const std::vector<Fixture>& fixtures() {
   using namespace collide::hard;
   static const std::vector<Fixture> list = {
-      {"mass-ratio", [] { return mass_ratio_family<float>(100, Fit::rigid, 41); }},
-      {"immovable", [] { return immovable_family<float>(90, Fit::rigid, 42); }},
-      {"grazing", [] { return grazing_family<float>(100, Fit::sphere, 43); }},
-      {"unit-scales", [] { return unit_scale_family<float>(100, Fit::rigid, 44); }},
-      {"separating-resting", [] { return separating_resting_family<float>(60, Fit::rigid, 45); }},
-      {"restitution", [] { return restitution_family<float>(100, Fit::particle, 46); }},
-      {"spin-dominated", [] { return spin_family<float>(100, Fit::rigid, 47); }},
+      {"mass-ratio", [] { return mass_ratio_family<float>(100, Model::rigid, 41); }},
+      {"immovable", [] { return immovable_family<float>(90, Model::rigid, 42); }},
+      {"grazing", [] { return grazing_family<float>(100, Model::sphere, 43); }},
+      {"unit-scales", [] { return unit_scale_family<float>(100, Model::rigid, 44); }},
+      {"separating-resting", [] { return separating_resting_family<float>(60, Model::rigid, 45); }},
+      {"restitution", [] { return restitution_family<float>(100, Model::particle, 46); }},
+      {"spin-dominated", [] { return spin_family<float>(100, Model::rigid, 47); }},
       {"cradle",
        [] {
          return cradle_scene<float>(12, {1, 0, 0}, true, true, false, 48);
        }},
-      {"star", [] { return star_scene<float>(150, false, Fit::sphere, 49); }},
-      {"cluster", [] { return cluster_scene<float>(30, 1.0, Fit::rigid, 50); }},
+      {"star", [] { return star_scene<float>(150, false, Model::sphere, 49); }},
+      {"cluster", [] { return cluster_scene<float>(30, 1.0, Model::rigid, 50); }},
   };
   return list;
 }

@@ -2,13 +2,13 @@
 //
 // What this proves
 // ----------------
-// For each family of hard_families.hpp - extreme mass ratios, immovable
+// For each family of collide/hard_scenes.hpp - extreme mass ratios, immovable
 // bodies, needle-thin inertia struck at the tip, long lever arms, grazing
 // approach, extreme unit scales, subnormal speeds, exactly separating and
 // exactly resting contacts, e = 0 and e = 1, friction at the stick/slip
 // boundary, spin-dominated contacts - 1000 random collisions from a fixed
 // seed, in float and double, for every body model the family applies to
-// (Fit::particle, Fit::sphere, Fit::rigid scenes, each run through every
+// (Model::particle, Model::sphere, Model::rigid scenes, each run through every
 // model that fits it):
 // * the kernel's impulses satisfy the documented bound against the long
 //   double reference with the reference's conditioning (impulse_scale), on
@@ -37,13 +37,13 @@ constexpr std::size_t kCount = 1000;
 
 /// The fits a family applies to. Rotation-free families also run for
 /// particles; needles are rigid by definition; spin and levers need rotation.
-const std::vector<Fit> kAllFits = {Fit::particle, Fit::sphere, Fit::rigid};
-const std::vector<Fit> kRotatingFits = {Fit::sphere, Fit::rigid};
+const std::vector<Model> kAllFits = {Model::particle, Model::sphere, Model::rigid};
+const std::vector<Model> kRotatingFits = {Model::sphere, Model::rigid};
 
 /// Runs `run(T{}, fit)` for T = float and double and every fit in `fits`.
 template <class Run>
-void each(const std::vector<Fit>& fits, const Run& run) {
-  for (const Fit fit : fits) {
+void each(const std::vector<Model>& fits, const Run& run) {
+  for (const Model fit : fits) {
     run(float{}, fit);
     run(double{}, fit);
   }
@@ -79,7 +79,7 @@ double widest_mass_ratio(const Scene<T>& s) {
 }
 
 TEST(HardPairs, MassRatiosUpTo1e8) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = mass_ratio_family<T>(kCount, fit, 11).scene();
     EXPECT_GE(widest_mass_ratio(s), 0.999e8);
@@ -113,7 +113,7 @@ void expect_immovable_law(const Scene<T>& in, const Outcome<T>& out, const Refer
 }
 
 TEST(HardPairs, ImmovableOnEitherSideAndBoth) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = immovable_family<T>(kCount, fit, 12).scene();
     run_scene<T>("immovable", s, fit, kCount / 2, expect_immovable_law<T>);
@@ -122,13 +122,13 @@ TEST(HardPairs, ImmovableOnEitherSideAndBoth) {
     // law says m = inf is immovable whatever its I, so nothing changes.
     BodyBuffer<T> stale = s.bodies;
     const BodyView<T> v = stale.view();
-    test::Rng rng(99);
+    SceneRng rng(99);
     std::size_t poisoned = 0;
     for (std::size_t i = 0; i < v.count; ++i) {
       if (v.inv_mass[i] != T(0)) continue;
       const T inv = static_cast<T>(rng.log_uniform(1e-3, 1e3));
       v.inv_inertia.x[i] = inv;
-      v.inv_inertia.y[i] = fit == Fit::rigid ? static_cast<T>(rng.log_uniform(1e-3, 1e3)) : inv;
+      v.inv_inertia.y[i] = fit == Model::rigid ? static_cast<T>(rng.log_uniform(1e-3, 1e3)) : inv;
       v.inv_inertia.z[i] = inv;
       ++poisoned;
     }
@@ -153,14 +153,14 @@ TEST(HardPairs, NeedleThinInertiaStruckAtTheTip) {
       thinnest = std::min(thinnest, lo / hi);
     }
     EXPECT_LE(thinnest, 1.0001e-12);
-    run_scene<T>("needle", s, Fit::rigid, kCount * 9 / 10, conserved<T>);
+    run_scene<T>("needle", s, Model::rigid, kCount * 9 / 10, conserved<T>);
   };
   run(float{});
   run(double{});
 }
 
 TEST(HardPairs, LongLeversUpTo1e4RadiiOfGyration) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const SceneRecords<T> r = long_lever_family<T>(kCount, fit, 14);
     double longest = 0;
@@ -179,7 +179,7 @@ TEST(HardPairs, LongLeversUpTo1e4RadiiOfGyration) {
 }
 
 TEST(HardPairs, GrazingApproachDownTo1e7) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const SceneRecords<T> r = grazing_family<T>(kCount, fit, 15);
     // vn / |u| from the stored values: the family reaches 1e-7 (up to the
@@ -201,7 +201,7 @@ TEST(HardPairs, GrazingApproachDownTo1e7) {
 }
 
 TEST(HardPairs, UnitScalesFrom1e5To1e5) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = unit_scale_family<T>(kCount, fit, 16).scene();
     const BodyView<const T> b = s.bodies.view();
@@ -217,7 +217,7 @@ TEST(HardPairs, UnitScalesFrom1e5To1e5) {
 }
 
 TEST(HardPairs, SubnormalSpeedsInFloat) {
-  for (const Fit fit : kAllFits) {
+  for (const Model fit : kAllFits) {
     const Scene<float> s = subnormal_family<float>(kCount, fit, 17).scene();
     run_scene<float>("subnormal", s, fit, kCount * 9 / 10,
                      [](const Scene<float>&, const Outcome<float>& out, const Reference&) {
@@ -256,7 +256,7 @@ void expect_untouched(const Scene<T>& in, const Outcome<T>& out, const Reference
 }
 
 TEST(HardPairs, ExactlySeparatingAndExactlyRestingLeftBitwiseUnchanged) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = separating_resting_family<T>(kCount, fit, 18).scene();
     run_scene<T>("separating-resting", s, fit, 0, expect_untouched<T>);
@@ -291,7 +291,7 @@ void expect_restitution_law(const Scene<T>& in, const Outcome<T>& out, const Ref
 }
 
 TEST(HardPairs, RestitutionZeroAndOne) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = restitution_family<T>(kCount, fit, 19).scene();
     run_scene<T>("e-0-and-1", s, fit, kCount * 9 / 10, expect_restitution_law<T>);
@@ -300,7 +300,7 @@ TEST(HardPairs, RestitutionZeroAndOne) {
 }
 
 TEST(HardPairs, FrictionAtTheStickSlipBoundary) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = stick_slip_family<T>(kCount, fit, 20).scene();
     run_scene<T>("stick-slip", s, fit, kCount * 9 / 10,
@@ -323,7 +323,7 @@ TEST(HardPairs, FrictionAtTheStickSlipBoundary) {
 }
 
 TEST(HardPairs, SpinDominated) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = spin_family<T>(kCount, fit, 21).scene();
     // |v| / (|w| |r|) reaches 1e-5 or less.

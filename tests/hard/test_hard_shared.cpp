@@ -10,7 +10,13 @@
 //   contact; with equal masses and e = 1 the last sphere leaves with the
 //   first one's velocity and the others stop; listed last to first, only
 //   the first two spheres exchange velocity (the order is the input's, not
-//   the geometry's); momentum is conserved and, for e = 1, energy too.
+//   the geometry's); momentum is conserved and, for e = 1, energy too. Every
+//   cradle is within the fast mode's target: along a random axis the float
+//   cradle with mixed masses measured 2.37 units while the kernels took the
+//   stored normal (unit only to a few eps) as unit, which scaled each link's
+//   impulse by |n|^2 and passed the factor down the chain (hard_attribution:
+//   the n term alone 1.2 units); fast_normal_impulse now folds |n|^2 into K
+//   (1.15 units).
 // * A star (one body in 1000 contacts, movable or immovable): the bound on
 //   every contact along the 1000-long chain, conservation, 1000 batches for
 //   a movable hub and one for an immovable one.
@@ -22,7 +28,6 @@
 #include <cstdint>
 #include <numeric>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -111,11 +116,11 @@ TEST_F(HardShared, NewtonsCradleInInputOrder) {
   auto run = [](auto zero) {
     using T = decltype(zero);
     const V3 x_axis{1, 0, 0};
-    test::Rng rng(31);
+    SceneRng rng(31);
     const V3 random_axis = rng.unit_vector();
     for (const bool aligned : {true, false}) {
       const V3& axis = aligned ? x_axis : random_axis;
-      const Fit fit = aligned ? Fit::particle : Fit::sphere;
+      const Model fit = aligned ? Model::particle : Model::sphere;
       for (const bool reversed : {false, true}) {
         SCOPED_TRACE(std::string(aligned ? "aligned" : "random axis") + (reversed ? " reversed" : ""));
         // Equal masses, elastic: the textbook motion.
@@ -127,18 +132,14 @@ TEST_F(HardShared, NewtonsCradleInInputOrder) {
                        expect_cradle_motion(in, out, reversed);
                        expect_scene_conserved(in, out, ref, true);
                      });
-        expect_deterministic(classic, model_of(fit));
+        expect_deterministic(classic, fit);
         // Mixed masses and restitution: whatever the motion, the bound and
         // the conservation laws.
         const Scene<T> mixed = cradle_scene<T>(kLongest, axis, false, false, reversed, 33).scene();
-        run_scene<T>(
-            "cradle-mixed", mixed, fit, kLongest - 1,
-            [](const Scene<T>& in, const Outcome<T>& out, const Reference& ref) {
-              expect_scene_conserved(in, out, ref, false);
-            },
-            // Open (issue 13): the float mixed cradle measures 2.37
-            // units, above the target of 2; held to the bound.
-            std::is_same_v<T, float> ? test::kErrorBoundEps : test::kErrorTargetEps);
+        run_scene<T>("cradle-mixed", mixed, fit, kLongest - 1,
+                     [](const Scene<T>& in, const Outcome<T>& out, const Reference& ref) {
+                       expect_scene_conserved(in, out, ref, false);
+                     });
       }
     }
   };
@@ -147,7 +148,7 @@ TEST_F(HardShared, NewtonsCradleInInputOrder) {
 }
 
 TEST_F(HardShared, StarOneBodyInAThousandContacts) {
-  auto run = [](auto zero, Fit fit, bool fixed_hub) {
+  auto run = [](auto zero, Model fit, bool fixed_hub) {
     using T = decltype(zero);
     SCOPED_TRACE(fixed_hub ? "immovable hub" : "movable hub");
     const Scene<T> s = star_scene<T>(1000, fixed_hub, fit, 34).scene();
@@ -161,9 +162,9 @@ TEST_F(HardShared, StarOneBodyInAThousandContacts) {
                      EXPECT_TRUE(test::same_bodies(in.bodies, out.bodies, [](std::size_t i) { return i != 0; }));
                    }
                  });
-    expect_deterministic(s, model_of(fit));
+    expect_deterministic(s, fit);
   };
-  for (const Fit fit : {Fit::particle, Fit::sphere, Fit::rigid}) {
+  for (const Model fit : {Model::particle, Model::sphere, Model::rigid}) {
     for (const bool fixed_hub : {false, true}) {
       run(float{}, fit, fixed_hub);
       run(double{}, fit, fixed_hub);
@@ -172,7 +173,7 @@ TEST_F(HardShared, StarOneBodyInAThousandContacts) {
 }
 
 TEST_F(HardShared, DenseCluster) {
-  auto run = [](auto zero, Fit fit) {
+  auto run = [](auto zero, Model fit) {
     using T = decltype(zero);
     const Scene<T> s = cluster_scene<T>(80, 1.0, fit, 35).scene();
     ASSERT_GE(s.contacts.size(), 800u);
@@ -181,9 +182,9 @@ TEST_F(HardShared, DenseCluster) {
                  [](const Scene<T>& in, const Outcome<T>& out, const Reference& ref) {
                    expect_scene_conserved(in, out, ref, false);
                  });
-    expect_deterministic(s, model_of(fit));
+    expect_deterministic(s, fit);
   };
-  for (const Fit fit : {Fit::particle, Fit::sphere, Fit::rigid}) {
+  for (const Model fit : {Model::particle, Model::sphere, Model::rigid}) {
     run(float{}, fit);
     run(double{}, fit);
   }

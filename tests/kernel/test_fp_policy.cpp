@@ -24,6 +24,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #if defined(__SSE__)
@@ -182,8 +183,10 @@ TEST(FpPolicy, ScalarAndSimdLanesAgreeWhereFmaWouldNot) {
 }
 
 // The library itself: head-on contacts (lever arms parallel to n, no spin,
-// n = +x) where the kernel computes, in this order,
-//   vn = va - vb, K = (1/ma + 1/mb) + 0 + 0, jn = -((1 + e) vn) / K,
+// n = +x, so |n|^2 = 1 exactly) where the rigid kernel computes, in this
+// order (contact_kernel.hpp, fast_normal_impulse),
+//   vn = va - vb, K = (1/ma + 1/mb) + 0 + 0, jn = -((1 + e) vn) / K
+//   (float: the sum, the product and the quotient in double, rounded once),
 //   va' = va + jn * (1/ma),  vb' = vb - jn * (1/mb).
 // The last two are multiply-adds. Inputs are drawn until fusing them would
 // change va'; the library must return the separately rounded value.
@@ -208,9 +211,16 @@ void expect_library_unfused(Path path) {
     // What the kernel will compute, separately rounded.
     const T inv_ma = T(1) / a.m, inv_mb = T(1) / b.m;
     volatile T vn = a.v[0] - b.v[0];
-    volatile T k = inv_ma + inv_mb;
-    volatile T num = (T(1) + e) * vn;
-    volatile T jn = -num / k;
+    volatile T jn;
+    if constexpr (std::is_same_v<T, float>) {
+      volatile double k = (double(inv_ma) + double(inv_mb)) * 1.0;
+      volatile double num = (1.0 + double(e)) * double(vn);
+      jn = static_cast<float>(-num / k);
+    } else {
+      volatile T k = inv_ma + inv_mb;
+      volatile T num = (T(1) + e) * vn;
+      jn = -num / k;
+    }
     const T va = unfused(T(jn), inv_ma, a.v[0]);
     const T vb = unfused(-T(jn), inv_mb, b.v[0]);  // vb - jn*inv_mb: -(jn*inv_mb) + vb
     const T fa = std::fma(T(jn), inv_ma, a.v[0]);

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "collide/generate.hpp"
+#include "collide/hard_scenes.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
-#include "hard/hard_families.hpp"
 #include "support/scenes.hpp"
 #include "support/solve_helpers.hpp"
 
@@ -210,19 +210,18 @@ void shared_and_hard_scenes() {
   SceneOptions o;
   o.friction = true;
   expect_same_bytes_on_every_isa(shared_scene<T>(3001, 300, o), Model::rigid, "shared");
-  using collide::hard::Fit;
-  expect_same_bytes_on_every_isa(collide::hard::mass_ratio_family<T>(301, Fit::rigid, 11).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::mass_ratio_family<T>(301, Model::rigid, 11).scene(), Model::rigid,
                                  "mass ratio");
-  expect_same_bytes_on_every_isa(collide::hard::immovable_family<T>(301, Fit::rigid, 12).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::immovable_family<T>(301, Model::rigid, 12).scene(), Model::rigid,
                                  "immovable");
   expect_same_bytes_on_every_isa(collide::hard::needle_family<T>(301, 13).scene(), Model::rigid, "needle");
-  expect_same_bytes_on_every_isa(collide::hard::long_lever_family<T>(301, Fit::rigid, 14).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::long_lever_family<T>(301, Model::rigid, 14).scene(), Model::rigid,
                                  "lever");
-  expect_same_bytes_on_every_isa(collide::hard::grazing_family<T>(301, Fit::rigid, 15).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::grazing_family<T>(301, Model::rigid, 15).scene(), Model::rigid,
                                  "grazing");
-  expect_same_bytes_on_every_isa(collide::hard::unit_scale_family<T>(301, Fit::rigid, 16).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::unit_scale_family<T>(301, Model::rigid, 16).scene(), Model::rigid,
                                  "scales");
-  expect_same_bytes_on_every_isa(collide::hard::subnormal_family<T>(301, Fit::rigid, 17).scene(), Model::rigid,
+  expect_same_bytes_on_every_isa(collide::hard::subnormal_family<T>(301, Model::rigid, 17).scene(), Model::rigid,
                                  "subnormal");
 }
 

@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "collide/generate.hpp"
+#include "collide/hard_scenes.hpp"
 #include "collide/packed.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
-#include "hard/hard_families.hpp"
 #include "support/scenes.hpp"
 #include "support/solve_helpers.hpp"
 
@@ -204,12 +204,11 @@ void shared_and_hard_scenes() {
   SceneOptions o;
   o.friction = true;
   expect_layouts_agree(shared_scene<T>(3001, 300, o), Model::rigid, "shared");
-  using collide::hard::Fit;
-  expect_layouts_agree(collide::hard::mass_ratio_family<T>(301, Fit::rigid, 21).scene(), Model::rigid, "mass ratio");
-  expect_layouts_agree(collide::hard::immovable_family<T>(301, Fit::rigid, 22).scene(), Model::rigid, "immovable");
+  expect_layouts_agree(collide::hard::mass_ratio_family<T>(301, Model::rigid, 21).scene(), Model::rigid, "mass ratio");
+  expect_layouts_agree(collide::hard::immovable_family<T>(301, Model::rigid, 22).scene(), Model::rigid, "immovable");
   expect_layouts_agree(collide::hard::needle_family<T>(301, 23).scene(), Model::rigid, "needle");
-  expect_layouts_agree(collide::hard::grazing_family<T>(301, Fit::rigid, 24).scene(), Model::rigid, "grazing");
-  expect_layouts_agree(collide::hard::subnormal_family<T>(301, Fit::rigid, 25).scene(), Model::rigid, "subnormal");
+  expect_layouts_agree(collide::hard::grazing_family<T>(301, Model::rigid, 24).scene(), Model::rigid, "grazing");
+  expect_layouts_agree(collide::hard::subnormal_family<T>(301, Model::rigid, 25).scene(), Model::rigid, "subnormal");
 }
 
 TEST(PackedLayout, SameBitsAsSoaSharedAndHardFloat) { shared_and_hard_scenes<float>(); }

@@ -33,6 +33,13 @@ namespace collide {
 /// change must not lose (the tests and `collide report --hard` check it).
 inline constexpr double kImpulseErrorTargetEps = 2.0;
 
+/// What the accurate mode (SolverOptions::accuracy = Accuracy::accurate)
+/// promises: the plain relative error of every J within this many ulps of
+/// its precision, |J - Jref| <= kAccurateErrorUlps (eps(T) |Jref| +
+/// denorm_min(T)), Jref the exact law on the stored inputs (issue 13;
+/// test_hard_accurate and `collide report --hard` check it).
+inline constexpr double kAccurateErrorUlps = 8.0;
+
 /// The normalised error of every contact (eps(T) * impulse_scale units): the
 /// kernel's impulses `j` against the reference's `ref`, whose diagnostics are
 /// `diag` (one per contact). Requires j.count == ref.count == diag.size().

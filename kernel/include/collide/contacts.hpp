@@ -32,6 +32,24 @@ struct ContactView {
   const T* mu = nullptr;         ///< Coulomb friction >= 0; nullptr = frictionless
 };
 
+/// Contacts first .. first + count - 1 of `v`, as a view of the same arrays
+/// (no copy, no renormalising). Requires first + count <= v.count.
+template <class T>
+ContactView<T> contact_slice(ContactView<T> v, std::size_t first, std::size_t count) {
+  v.count = count;
+  v.a += first;
+  v.b += first;
+  v.c.x += first;
+  v.c.y += first;
+  v.c.z += first;
+  v.n.x += first;
+  v.n.y += first;
+  v.n.z += first;
+  if (v.e) v.e += first;
+  if (v.mu) v.mu += first;
+  return v;
+}
+
 /// Non-owning view of the impulse output: J, the total impulse on body a [N s].
 template <class T>
 struct ImpulseView {

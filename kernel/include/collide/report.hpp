@@ -1,7 +1,8 @@
 // collide/report.hpp - the report engine: speed against error of every
 // variant of the solver (and the reference, the textbook loop, the Bullet
-// peer) on the pairs and the debris scene, as rows, and the writers of the
-// table, the JSON and the plot. `collide report` and collide.report() in
+// peer) on the pairs and the debris scene, as rows, optionally the hard
+// scenes of collide/hard_scenes.hpp in both accuracy modes, and the writers
+// of the table, the JSON and the plot. `collide report` and collide.report() in
 // Python are thin shells over it.
 //
 // Design notes
@@ -61,6 +62,35 @@ struct ReportRow {
 /// "accurate" (the SIMD path with SolverOptions::accuracy = accurate).
 bool is_kernel_variant(const std::string& variant);
 
+/// One hard scene (collide/hard_scenes.hpp, the catalogue) measured in one
+/// precision and one accuracy mode (`collide report --hard`): speed and
+/// error, in the fast mode's unit and in the accurate mode's.
+struct HardRow {
+  std::string family;      ///< hard::hard_scene_catalogue() name ("mass-ratio", "cradle-mixed", ...)
+  std::string model;       ///< the model the scene is shaped for and solved with (the cheapest that fits)
+  std::string precision;   ///< "float" or "double"
+  std::string mode;        ///< "fast" or "accurate" (SolverOptions::accuracy)
+  bool shared = false;     ///< contacts share bodies (a chain: cradles, stars, the cluster)
+  std::size_t n = 0;       ///< contacts of the scene
+  std::size_t acting = 0;  ///< contacts with an impulse in the reference
+  int threads = 1;
+  std::string isa;  ///< the SIMD kernel's ISA
+  int runs = 0;     ///< timed runs; the speed is their median
+  double seconds = 0;
+  double collisions_per_second = 0;
+  double max_err_eps = 0;  ///< max |J - Jref| / (eps impulse_scale), the fast mode's unit (error_bound.hpp)
+  double p99_err_eps = 0;  ///< 99th percentile of the same
+  /// Max plain relative error of J in ulps of the precision, |J - Jref| /
+  /// (eps |Jref| + denorm_min), the accurate mode's unit (kAccurateErrorUlps).
+  /// Shared scenes: each contact against the law applied to the velocities
+  /// as stored before it, which the mode's own solve leaves.
+  double max_err_ulps = 0;
+  /// Precision of the reference for max_err_ulps: "long double" (float),
+  /// "__float128" (double), or "none" for double in a build without
+  /// __float128, where max_err_ulps is NaN (not measured).
+  std::string judge;
+};
+
 /// One point of the throughput-against-N sweep (pairs scene, SIMD, float).
 struct SweepPoint {
   std::string model;
@@ -92,11 +122,13 @@ struct Report {
   std::size_t error_sample = 0;
   bool quick = false;
   double wall_seconds = 0;
-  /// Wall time of each phase ("triad", "pairs", "debris", "sweep"), for budgeting.
+  /// Wall time of each phase ("triad", "pairs", "debris", "hard", "sweep"), for budgeting.
   std::vector<std::pair<std::string, double>> phase_seconds;
   std::vector<ReportRow> rows;
   std::vector<SweepPoint> sweep;
-  std::string peer_status;  ///< "bullet 3.24" or why there is no peer row
+  std::size_t hard_n = 0;     ///< pairs of each hard pair family (0: no hard section)
+  std::vector<HardRow> hard;  ///< the hard section (--hard), in catalogue order
+  std::string peer_status;    ///< "bullet 3.24" or why there is no peer row
 };
 
 // ---------------------------------------------------------------------------
@@ -114,6 +146,10 @@ struct ReportOptions {
   std::size_t debris_n = 1000000;     ///< collisions of the debris scene
   std::size_t slow_n = 500000;        ///< contacts of the slow (single-threaded, unvectorised) rows
   std::vector<std::size_t> sweep_n;   ///< N of the throughput sweep; empty: no sweep
+  /// The hard section: every scene of hard::hard_scene_catalogue() in float
+  /// and double, fast and accurate, SIMD at one thread (`--hard`).
+  bool hard = false;
+  std::size_t hard_n = 1000;  ///< pairs of each hard pair family (the shared scenes have fixed sizes)
 };
 
 /// Measures every row (and the sweep) and returns them in canonical order
@@ -129,7 +165,8 @@ Report measure_report(const ReportOptions& options);
 void sort_report_rows(Report& report);
 /// The fixed-width table printed on stdout.
 std::string format_report_table(const Report& report);
-/// The JSON document: {"machine": ..., "rows": [one object per row], "sweep": [...]}.
+/// The JSON document: {"machine": ..., "rows": [one object per row], "hard": [one object per
+/// hard row; empty without --hard], "sweep": [...]}.
 std::string format_report_json(const Report& report);
 /// Writes the PNG with gnuplot. Returns "" on success, or why it failed.
 std::string write_report_plot(const Report& report, const std::string& png_path);

@@ -1,8 +1,10 @@
-// report/measure.hpp - what the rows of the report share (measure.cpp) and
-// the Bullet peer row (bullet_row.cpp); private to the report engine.
+// report/measure.hpp - what the rows of the report share (measure.cpp), the
+// hard section (hard_rows.cpp) and the Bullet peer row (bullet_row.cpp);
+// private to the report engine.
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,16 @@ void fill_error(ReportRow& row, const ImpulseView<const T>& impulses, const Body
 
 /// Median of a list of run times.
 double median(std::vector<double> values);
+
+// ---------------------------------------------------------------------------
+// The hard section (hard_rows.cpp).
+// ---------------------------------------------------------------------------
+
+/// Every scene of hard::hard_scene_catalogue() in float and double (float
+/// only where the scene is meant for float), fast then accurate, in
+/// catalogue order; `progress` is told what runs.
+std::vector<HardRow> measure_hard_rows(const ReportOptions& options,
+                                       const std::function<void(const std::string&)>& progress);
 
 // ---------------------------------------------------------------------------
 // The peer (bullet_row.cpp, only with COLLIDE_WITH_BULLET).

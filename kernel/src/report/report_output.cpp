@@ -21,6 +21,10 @@
 //   number of pairs, with the bandwidth bound of each model as a horizontal
 //   line and the N at which the model's working set (bytes_per_collision x N)
 //   fills the L2 caches of the threads and the L3 as vertical lines.
+// * Panel 3, only with --hard: every hard row (collide/hard_scenes.hpp) as a
+//   point, throughput against its max plain relative error (max_err_ulps x
+//   eps), one series per mode and precision, so the cost and the gain of the
+//   accurate mode on the hard cases are one picture.
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -43,6 +47,7 @@
 #include <tuple>
 #include <vector>
 
+#include "collide/check.hpp"
 #include "collide/error_bound.hpp"
 #include "collide/model.hpp"
 #include "collide/report.hpp"
@@ -180,6 +185,30 @@ std::string format_report_table(const Report& report) {
         r.note.c_str());
     out += line;
   }
+  if (!report.hard.empty()) {
+    std::snprintf(line, sizeof line,
+                  "\nhard scenes (--hard; collide/hard_scenes.hpp): %zu pairs per pair family, the shared scenes at "
+                  "their sizes;\n"
+                  "  simd, 1 thread, solved by the model each scene is shaped for; err in eps x impulse scale vs long "
+                  "double\n"
+                  "  (fast mode's target %.0f), ulps = max |J-Jref| / (eps |Jref|) vs the exact law (accurate mode's "
+                  "bound %.0f;\n"
+                  "  shared scenes: each contact on the state stored before it).\n",
+                  report.hard_n, kImpulseErrorTargetEps, kAccurateErrorUlps);
+    out += line;
+    out +=
+        "family             model    precision mode      isa      n    act  Mcoll/s   max err   p99 err     max ulps\n";
+    std::string previous;
+    for (const HardRow& h : report.hard) {
+      if (!previous.empty() && h.family != previous) out += "\n";
+      previous = h.family;
+      const std::string ulps = std::isnan(h.max_err_ulps) ? "n/a" : format("%.4g", h.max_err_ulps);
+      std::snprintf(line, sizeof line, "%-18s %-8s %-9s %-8s %-6s %6zu %6zu %8.2f %9.3g %9.3g %12s\n", h.family.c_str(),
+                    h.model.c_str(), h.precision.c_str(), h.mode.c_str(), h.isa.c_str(), h.n, h.acting,
+                    h.collisions_per_second / 1e6, h.max_err_eps, h.p99_err_eps, ulps.c_str());
+      out += line;
+    }
+  }
   if (!report.sweep.empty()) {
     out += "\nthroughput against N (pairs, simd float, frictionless):\n";
     out += "model         N  thr  runs  Mcoll/s     bw\n";
@@ -254,6 +283,23 @@ std::string format_report_json(const Report& report) {
          ", \"angular_momentum_drift\": " + json_number(r.angular_momentum_drift) +
          ", \"energy_drift\": " + json_number(r.energy_drift) + ", \"note\": " + json_string(r.note) + "}" +
          (i + 1 < report.rows.size() ? ",\n" : "\n");
+  }
+  s += "  ],\n  \"hard_n\": " + std::to_string(report.hard_n) + ",\n";
+  s += "  \"accurate_error_ulps\": " + json_number(kAccurateErrorUlps) + ",\n";
+  s += "  \"impulse_error_target_eps\": " + json_number(kImpulseErrorTargetEps) + ",\n";
+  s += "  \"hard\": [\n";
+  for (std::size_t i = 0; i < report.hard.size(); ++i) {
+    const HardRow& h = report.hard[i];
+    s += "    {\"family\": " + json_string(h.family) + ", \"model\": " + json_string(h.model) +
+         ", \"precision\": " + json_string(h.precision) + ", \"mode\": " + json_string(h.mode) +
+         ", \"shared\": " + (h.shared ? "true" : "false") + ", \"n\": " + std::to_string(h.n) +
+         ", \"acting\": " + std::to_string(h.acting) + ", \"threads\": " + std::to_string(h.threads) +
+         ", \"isa\": " + json_string(h.isa) + ", \"runs\": " + std::to_string(h.runs) +
+         ", \"seconds\": " + json_number(h.seconds) +
+         ", \"collisions_per_second\": " + json_number(h.collisions_per_second) +
+         ", \"max_err_eps\": " + json_number(h.max_err_eps) + ", \"p99_err_eps\": " + json_number(h.p99_err_eps) +
+         ", \"max_err_ulps\": " + json_number(h.max_err_ulps) + ", \"judge\": " + json_string(h.judge) + "}" +
+         (i + 1 < report.hard.size() ? ",\n" : "\n");
   }
   s += "  ],\n  \"sweep\": [\n";
   for (std::size_t i = 0; i < report.sweep.size(); ++i) {
@@ -388,12 +434,26 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
     std::ofstream(tmp / ("sweep-" + model + ".dat")) << text;
   }
 
+  // Panel 3 data: one file per mode and precision.
+  std::map<std::string, std::string> hard;
+  for (const HardRow& h : report.hard) {
+    const double error =
+        h.max_err_ulps > 0 ? h.max_err_ulps * (h.precision == "float" ? 0x1p-23 : 0x1p-52) : kZeroErrorAt;
+    hard[h.mode + " " + h.precision] += format("%.6e", error) + " " + format("%.6e", h.collisions_per_second) + "\n";
+  }
+  for (const auto& [series, text] : hard) {
+    std::string file = series;
+    std::replace(file.begin(), file.end(), ' ', '-');
+    std::ofstream(tmp / ("hard-" + file + ".dat")) << text;
+  }
+  const bool hard_panel = !hard.empty();
+
   const std::filesystem::path out_png = std::filesystem::absolute(png_path);
   const std::filesystem::path temp_png = out_png.string() + ".tmp-" + std::to_string(::getpid()) + ".png";
   std::ostringstream gp;
-  gp << "set terminal pngcairo size 1600,760 font 'DejaVu Sans,10' noenhanced\n";
+  gp << "set terminal pngcairo size " << (hard_panel ? "2400" : "1600") << ",760 font 'DejaVu Sans,10' noenhanced\n";
   gp << "set output " << gp_string(temp_png.string()) << "\n";
-  gp << "set multiplot layout 1,2 title "
+  gp << "set multiplot layout 1," << (hard_panel ? 3 : 2) << " title "
      << gp_string("collide report: " + report.machine.cpu + ", " + std::to_string(report.machine.hardware_threads) +
                   " hardware threads, " + std::to_string(report.n) + " pairs per speed run")
      << " font ',12'\n";
@@ -484,6 +544,28 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
     gp << "set label 1 'no sweep' at graph 0.5, graph 0.5 center\nplot 1/0 notitle\n";
   } else {
     gp << "plot " << plot2 << "\n";
+  }
+  if (hard_panel) {
+    // Panel 3: the hard scenes.
+    gp << "unset arrow\nunset label\nunset ytics\nset ytics\nset autoscale y\n";
+    gp << "set title "
+       << gp_string("Hard scenes (--hard): throughput against error, fast and accurate (simd, 1 thread)") << "\n";
+    gp << "set xlabel 'max |J - Jref| / |Jref| per scene (exact-law reference; 0 drawn at 1e-20)'\n";
+    gp << "set ylabel 'collisions per second'\nset format x '%.0e'\nset format y '%.0s%c'\n";
+    gp << "set xrange [" << format("%.1e", kZeroErrorAt / 10) << ":1e3]\nset key top left box opaque\n";
+    const std::map<std::string, std::string> style = {{"fast float", "pt 7 lc rgb '#d62728'"},
+                                                      {"fast double", "pt 9 lc rgb '#d62728'"},
+                                                      {"accurate float", "pt 7 lc rgb '#9467bd'"},
+                                                      {"accurate double", "pt 9 lc rgb '#9467bd'"}};
+    std::string plot3;
+    for (const auto& [series, text] : hard) {
+      std::string file = series;
+      std::replace(file.begin(), file.end(), ' ', '-');
+      if (!plot3.empty()) plot3 += ", \\\n  ";
+      plot3 += gp_string((tmp / ("hard-" + file + ".dat")).string()) + " using 1:2 with points ps 1.1 " +
+               (style.count(series) ? style.at(series) : std::string("pt 7")) + " title " + gp_string(series);
+    }
+    gp << "plot " << plot3 << "\n";
   }
   gp << "unset multiplot\nset output\n";
   std::ofstream(tmp / "report.gp") << gp.str();

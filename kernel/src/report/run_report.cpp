@@ -38,9 +38,11 @@
 //   precision (46 MB of bodies and more).
 // * The N sweep (panel 2 of the plot) runs on prefixes of one pairs scene of
 //   the largest N: the first N pairs of the pairs scene are the N-pair scene.
+// * The hard section (--hard, hard_rows.cpp) runs after the two scenes:
+//   every hard scene of collide/hard_scenes.hpp in both accuracy modes.
 // * A kernel variant whose error exceeds kImpulseErrorBoundEps makes the
-//   command exit 3, like `solve --check`; the table and files are written
-//   first.
+//   command exit 3, like `solve --check` (and a hard row of the accurate
+//   mode above kAccurateErrorUlps); the table and files are written first.
 #include <unistd.h>
 
 #include <algorithm>
@@ -223,6 +225,10 @@ class Runner {
         run_scene<float>(kind, friction);
       }
       end_phase(scene_name(kind));
+    }
+    if (config_.hard) {
+      report_.hard = measure_hard_rows(config_, [&](const std::string& what) { progress_->show(what); });
+      end_phase("hard");
     }
     if (!config_.sweep_n.empty()) {
       run_sweep();
@@ -582,6 +588,7 @@ Report measure_report(const ReportOptions& options) {
   for (const std::size_t n : options.sweep_n) {
     require(n >= 1 && n <= 0x7FFFFFFFULL, "sweep sizes must be from 1 to 2^31 - 1");
   }
+  require(options.hard_n >= 1 && options.hard_n <= 0x7FFFFFFFULL, "hard_n must be from 1 to 2^31 - 1");
   const auto t0 = Clock::now();
   Report report;
   report.n = options.n;
@@ -589,6 +596,7 @@ Report measure_report(const ReportOptions& options) {
   report.error_sample =
       options.quick ? std::min(options.sample, std::min(options.n, options.debris_n)) : options.sample;
   report.quick = options.quick;
+  report.hard_n = options.hard ? options.hard_n : 0;
   const std::string bullet = bullet_version();
   report.peer_status = bullet.empty() ? "not built (libbullet-dev was not found by pkg-config at configure time)"
                                       : bullet + ", btSequentialImpulseConstraintSolver";
