@@ -29,6 +29,8 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include "narrow_records.hpp"
+
 namespace collide {
 namespace {
 
@@ -148,33 +150,7 @@ double debris_half_extent(std::size_t movable) {
   return std::cbrt(static_cast<double>(std::max<std::size_t>(movable, 1)));
 }
 
-template <class T>
-BodyRecord<T> narrow(const BodyRecord<double>& r) {
-  BodyRecord<T> o;
-  o.m = static_cast<T>(r.m);
-  for (int k = 0; k < 3; ++k) {
-    o.I[k] = static_cast<T>(r.I[k]);
-    o.p[k] = static_cast<T>(r.p[k]);
-    o.v[k] = static_cast<T>(r.v[k]);
-    o.w[k] = static_cast<T>(r.w[k]);
-  }
-  for (int k = 0; k < 4; ++k) o.q[k] = static_cast<T>(r.q[k]);
-  return o;
-}
-
-template <class T>
-ContactRecord<T> narrow(const ContactRecord<double>& r) {
-  ContactRecord<T> o;
-  o.a = r.a;
-  o.b = r.b;
-  for (int k = 0; k < 3; ++k) {
-    o.c[k] = static_cast<T>(r.c[k]);
-    o.n[k] = static_cast<T>(r.n[k]);
-  }
-  o.e = static_cast<T>(r.e);
-  o.mu = static_cast<T>(r.mu);
-  return o;
-}
+using detail::narrow;
 
 }  // namespace
 

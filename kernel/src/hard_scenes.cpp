@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "collide/reference.hpp"
+#include "narrow_records.hpp"
 
 namespace collide {
 
@@ -180,33 +181,8 @@ Pair base_pair(SceneRng& rng, Model fit, bool friction) {
   return p;
 }
 
-template <class T>
-BodyRecord<T> stored(const BodyRecord<double>& b) {
-  BodyRecord<T> r;
-  r.m = static_cast<T>(b.m);
-  for (int i = 0; i < 3; ++i) {
-    r.I[i] = static_cast<T>(b.I[i]);
-    r.p[i] = static_cast<T>(b.p[i]);
-    r.v[i] = static_cast<T>(b.v[i]);
-    r.w[i] = static_cast<T>(b.w[i]);
-  }
-  for (int i = 0; i < 4; ++i) r.q[i] = static_cast<T>(b.q[i]);
-  return r;
-}
-
-template <class T>
-ContactRecord<T> stored(const ContactRecord<double>& c) {
-  ContactRecord<T> r;
-  r.a = c.a;
-  r.b = c.b;
-  for (int i = 0; i < 3; ++i) {
-    r.c[i] = static_cast<T>(c.c[i]);
-    r.n[i] = static_cast<T>(c.n[i]);
-  }
-  r.e = static_cast<T>(c.e);
-  r.mu = static_cast<T>(c.mu);
-  return r;
-}
+/// The drawn double records in the scene's precision (narrow_records.hpp).
+using detail::narrow;
 
 /// Appends pair k in T: side a is body 2k and side b body 2k+1 for even k,
 /// the other way round for odd k (the SIMD path's gather layout).
@@ -224,8 +200,8 @@ void push_pair(SceneRecords<T>& s, const BodyRecord<T>& a, const BodyRecord<T>& 
 /// Stores a drawn pair in T, made approaching on the stored values.
 template <class T>
 void push_approaching(SceneRecords<T>& s, const Pair& p) {
-  const BodyRecord<T> a = stored<T>(p.a), b = stored<T>(p.b);
-  ContactRecord<T> c = stored<T>(p.c);
+  const BodyRecord<T> a = narrow<T>(p.a), b = narrow<T>(p.b);
+  ContactRecord<T> c = narrow<T>(p.c);
   make_approach(a, b, c);
   push_pair(s, a, b, c);
 }
@@ -321,9 +297,9 @@ SceneRecords<T> grazing_family(std::size_t count, Model fit, std::uint64_t seed)
   SceneRecords<T> s;
   for (std::size_t k = 0; k < count; ++k) {
     const Pair p = base_pair(rng, fit, k % 2 == 1);
-    BodyRecord<T> a = stored<T>(p.a);
-    const BodyRecord<T> b = stored<T>(p.b);
-    ContactRecord<T> c = stored<T>(p.c);
+    BodyRecord<T> a = narrow<T>(p.a);
+    const BodyRecord<T> b = narrow<T>(p.b);
+    ContactRecord<T> c = narrow<T>(p.c);
     const double ratio = decade(rng, -7, 0, k, 25, -7);
     const V3 n{double(c.n[0]), double(c.n[1]), double(c.n[2])};
     const V3 t = perpendicular(rng, n);
@@ -380,8 +356,8 @@ SceneRecords<T> separating_resting_family(std::size_t count, Model fit, std::uin
     Pair p = base_pair(rng, fit, (k / 2) % 2 == 0);
     if (k % 2 == 0) {
       for (;;) {
-        BodyRecord<T> a = stored<T>(p.a), b = stored<T>(p.b);
-        ContactRecord<T> c = stored<T>(p.c);
+        BodyRecord<T> a = narrow<T>(p.a), b = narrow<T>(p.b);
+        ContactRecord<T> c = narrow<T>(p.c);
         const std::array<L, 3> u = relative_velocity(a, b, c);
         const L vn = u[0] * L(c.n[0]) + u[1] * L(c.n[1]) + u[2] * L(c.n[2]);
         const L speed = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
@@ -399,8 +375,8 @@ SceneRecords<T> separating_resting_family(std::size_t count, Model fit, std::uin
     const int axis = static_cast<int>(rng.index(3));
     const double sign = rng.chance(0.5) ? 1 : -1;
     for (int i = 0; i < 3; ++i) p.c.n[i] = i == axis ? sign : 0;
-    BodyRecord<T> a = stored<T>(p.a), b = stored<T>(p.b);
-    ContactRecord<T> c = stored<T>(p.c);
+    BodyRecord<T> a = narrow<T>(p.a), b = narrow<T>(p.b);
+    ContactRecord<T> c = narrow<T>(p.c);
     b.v[axis] = a.v[axis];
     for (BodyRecord<T>* body : {&a, &b}) {
       // Either w parallel to n (particles have no spin at all) or r parallel
@@ -486,7 +462,7 @@ SceneRecords<T> cradle_scene(std::size_t longest, const V3& axis, bool elastic, 
         b.p[d] = origin[d] + 2 * radius * double(i) * axis[d];
         b.v[d] = i == 0 ? v0 * axis[d] : 0;
       }
-      s.bodies.push_back(stored<T>(b));
+      s.bodies.push_back(narrow<T>(b));
     }
     std::vector<ContactRecord<T>> chain;
     for (std::size_t i = 0; i + 1 < n; ++i) {
@@ -499,7 +475,7 @@ SceneRecords<T> cradle_scene(std::size_t longest, const V3& axis, bool elastic, 
       }
       c.e = elastic ? 1 : rng.uniform(0, 1);
       c.mu = 0;
-      chain.push_back(stored<T>(c));
+      chain.push_back(narrow<T>(c));
     }
     if (reversed) std::reverse(chain.begin(), chain.end());
     s.contacts.insert(s.contacts.end(), chain.begin(), chain.end());
@@ -517,7 +493,7 @@ SceneRecords<T> star_scene(std::size_t spokes, bool fixed_hub, Model fit, std::u
   shape(hub, fit, rng);
   if (fixed_hub) hub.m = std::numeric_limits<double>::infinity();
   const double hub_radius = 1.0;
-  s.bodies.push_back(stored<T>(hub));
+  s.bodies.push_back(narrow<T>(hub));
   for (std::size_t k = 0; k < spokes; ++k) {
     const V3 d = rng.unit_vector();
     const double radius = rng.uniform(0.05, 0.3);
@@ -525,7 +501,7 @@ SceneRecords<T> star_scene(std::size_t spokes, bool fixed_hub, Model fit, std::u
     shape(sat, fit, rng);
     const double speed = rng.uniform(0.5, 5);
     for (int i = 0; i < 3; ++i) sat.v[i] = -speed * d[i] + rng.uniform(-1, 1);
-    s.bodies.push_back(stored<T>(sat));
+    s.bodies.push_back(narrow<T>(sat));
     ContactRecord<double> c;
     c.a = static_cast<BodyIndex>(k + 1);
     c.b = 0;
@@ -535,7 +511,7 @@ SceneRecords<T> star_scene(std::size_t spokes, bool fixed_hub, Model fit, std::u
     }
     c.e = rng.uniform(0, 1);
     c.mu = k % 2 == 0 ? rng.uniform(0, 1) : 0;
-    s.contacts.push_back(stored<T>(c));
+    s.contacts.push_back(narrow<T>(c));
   }
   return s;
 }
@@ -548,7 +524,7 @@ SceneRecords<T> cluster_scene(std::size_t count, double reach, Model fit, std::u
   for (std::size_t i = 0; i < count; ++i) {
     bodies.push_back(random_body<double>(rng, rng.in_box(1)));
     shape(bodies.back(), fit, rng);
-    s.bodies.push_back(stored<T>(bodies.back()));
+    s.bodies.push_back(narrow<T>(bodies.back()));
   }
   std::vector<ContactRecord<T>> contacts;
   for (std::size_t i = 0; i < count; ++i) {
@@ -565,7 +541,7 @@ SceneRecords<T> cluster_scene(std::size_t count, double reach, Model fit, std::u
       }
       c.e = rng.uniform(0, 1);
       c.mu = rng.chance(0.5) ? rng.uniform(0, 1) : 0;
-      contacts.push_back(stored<T>(c));
+      contacts.push_back(narrow<T>(c));
     }
   }
   for (std::size_t k = contacts.size(); k > 1; --k) std::swap(contacts[k - 1], contacts[rng.index(k)]);
