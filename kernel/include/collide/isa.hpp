@@ -34,8 +34,8 @@ Isa parse_isa(std::string_view name);
 
 /// True when this CPU and OS can run `isa` and this build has a kernel for it
 /// (automatic: always; a clang build has no AVX-512 kernel, CMakeLists.txt
-/// says why; a build configured with COLLIDE_KERNEL_ISAS has only those). On a non-x86 build only sse2 and automatic are "supported":
-/// there the lanes are the target's own and the name is nominal.
+/// says why; a build configured with COLLIDE_KERNEL_ISAS has only those). On a non-x86 build only sse2 and automatic
+/// are "supported": there the lanes are the target's own and the name is nominal.
 bool isa_supported(Isa isa);
 
 /// The widest ISA this CPU supports, detected once.
