@@ -38,6 +38,7 @@
 #include "collide/error_bound.hpp"
 #include "collide/isa.hpp"
 #include "support/mini_json.hpp"
+#include "support/report_run.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
@@ -45,7 +46,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using collide::test::Json;
-using collide::test::JsonParser;
 using collide::test::RunResult;
 using collide::test::slurp;
 
@@ -61,28 +61,15 @@ RunResult run(const fs::path& dir, const std::vector<std::string>& args) {
 class ReportRun : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(fs::path(COLLIDE_TEST_TMP) / "report");
-    fs::remove_all(*dir_);
-    fs::create_directories(*dir_);
-    result_ = new RunResult(run(*dir_, {"report", "--quick", "--n", "20000", "--json", (*dir_ / "report.json").string(),
-                                        "--plot", (*dir_ / "report.png").string()}));
-    json_ = new Json;
-    if (fs::exists(*dir_ / "report.json")) *json_ = JsonParser(slurp(*dir_ / "report.json")).parse();
+    report_ =
+        collide::test::run_report(COLLIDE_CLI_PATH, fs::path(COLLIDE_TEST_TMP) / "report", {"--quick", "--n", "20000"});
   }
-  static void TearDownTestSuite() {
-    delete json_;
-    delete result_;
-    delete dir_;
-  }
-  static const std::vector<Json>& rows() { return json_->at("rows").items; }
+  static void TearDownTestSuite() { report_.reset(); }
+  static const std::vector<Json>& rows() { return report_->json.at("rows").items; }
 
-  static fs::path* dir_;
-  static RunResult* result_;
-  static Json* json_;
+  static std::unique_ptr<const collide::test::ReportOutput> report_;
 };
-fs::path* ReportRun::dir_ = nullptr;
-RunResult* ReportRun::result_ = nullptr;
-Json* ReportRun::json_ = nullptr;
+std::unique_ptr<const collide::test::ReportOutput> ReportRun::report_;
 
 const char* const kRequired[] = {"scene",
                                  "variant",
@@ -117,13 +104,13 @@ bool is_kernel(const Json& row) {
 }
 
 TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
-  ASSERT_EQ(result_->exit_code, 0) << result_->err;
-  EXPECT_NE(result_->out.find("scene   fric variant"), std::string::npos) << result_->out;
-  EXPECT_NE(result_->out.find("wall time"), std::string::npos);
-  ASSERT_EQ(json_->kind, Json::object);
+  ASSERT_EQ(report_->result.exit_code, 0) << report_->result.err;
+  EXPECT_NE(report_->result.out.find("scene   fric variant"), std::string::npos) << report_->result.out;
+  EXPECT_NE(report_->result.out.find("wall time"), std::string::npos);
+  ASSERT_EQ(report_->json.kind, Json::object);
   // One table line per row: every row's variant and model appear in order.
   std::size_t lines = 0;
-  std::istringstream table(result_->out);
+  std::istringstream table(report_->result.out);
   for (std::string line; std::getline(table, line);) {
     if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0) ++lines;
   }
@@ -133,8 +120,8 @@ TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
 TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {
   // Each cache size is the library's (/sys, else sysconf, else CPUID): a
   // positive number, or null in JSON and "unknown" in the text - never 0.
-  ASSERT_TRUE(json_->has("machine")) << result_->err;
-  const Json& m = json_->at("machine");
+  ASSERT_TRUE(report_->json.has("machine")) << report_->result.err;
+  const Json& m = report_->json.at("machine");
   const std::pair<const char*, int> caches[] = {{"l1d_bytes", 1}, {"l2_bytes", 2}, {"l3_bytes", 3}};
   for (const auto& [key, level] : caches) {
     ASSERT_TRUE(m.has(key)) << key;
@@ -146,9 +133,9 @@ TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {
       EXPECT_EQ(m.at(key).kind, Json::null) << key;
     }
   }
-  const std::size_t at = result_->out.find("machine: ");
-  ASSERT_NE(at, std::string::npos) << result_->out;
-  const std::string line = result_->out.substr(at, result_->out.find('\n', at) - at);
+  const std::size_t at = report_->result.out.find("machine: ");
+  ASSERT_NE(at, std::string::npos) << report_->result.out;
+  const std::string line = report_->result.out.substr(at, report_->result.out.find('\n', at) - at);
   EXPECT_EQ(line.find(" 0 KiB"), std::string::npos) << line;
   if (!collide::cache_bytes(1)) {
     EXPECT_NE(line.find("L1d unknown"), std::string::npos) << line;
@@ -158,7 +145,7 @@ TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {
 }
 
 TEST_F(ReportRun, JsonHoldsEveryVariant) {
-  ASSERT_TRUE(json_->has("rows")) << result_->err;
+  ASSERT_TRUE(report_->json.has("rows")) << report_->result.err;
   std::set<Key> seen;
   for (const Json& row : rows()) {
     for (const char* field : kRequired) ASSERT_TRUE(row.has(field)) << "missing " << field;
@@ -194,7 +181,7 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
     }
   }
   // The peer row exists exactly when the report says Bullet was built in.
-  const bool bullet = json_->at("peer").str.rfind("bullet", 0) == 0;
+  const bool bullet = report_->json.at("peer").str.rfind("bullet", 0) == 0;
   if (bullet) expected.insert({"pairs", false, "bullet", "float", "rigid", 1, "sse2"});
   for (const Key& k : expected) {
     EXPECT_EQ(seen.count(k), 1U) << "no row for " << std::get<0>(k) << (std::get<1>(k) ? " friction " : " ")
@@ -205,7 +192,7 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
 }
 
 TEST_F(ReportRun, ValuesAreSane) {
-  ASSERT_TRUE(json_->has("rows"));
+  ASSERT_TRUE(report_->json.has("rows"));
   for (const Json& row : rows()) {
     SCOPED_TRACE(row.at("scene").str + " " + row.at("variant").str + " " + row.at("precision").str + " " +
                  row.at("model").str + " t" + std::to_string(static_cast<int>(row.at("threads").num)) +
@@ -242,7 +229,7 @@ TEST_F(ReportRun, ValuesAreSane) {
 }
 
 TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
-  ASSERT_TRUE(json_->has("rows"));
+  ASSERT_TRUE(report_->json.has("rows"));
   // The paths and thread counts agree bit for bit, so their errors do too.
   std::map<std::tuple<std::string, bool, std::string, std::string>, double> first;
   for (const Json& row : rows()) {
@@ -258,7 +245,7 @@ TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
 }
 
 TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
-  ASSERT_TRUE(json_->has("rows"));
+  ASSERT_TRUE(report_->json.has("rows"));
   // The accurate variant (issue 13) on independent pairs: J within 8 ulps
   // of the long double reference, which judges float exactly enough; and
   // never less accurate than the fast SIMD row of the same scene.
@@ -276,25 +263,25 @@ TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
 
 TEST_F(ReportRun, NoHardRowsWithoutTheFlag) {
   // The hard section is `--hard` only (test_report_hard.cpp runs it).
-  ASSERT_TRUE(json_->has("hard"));
-  EXPECT_TRUE(json_->at("hard").items.empty());
-  EXPECT_EQ(json_->at("hard_n").num, 0);
-  EXPECT_EQ(result_->out.find("hard scenes"), std::string::npos);
+  ASSERT_TRUE(report_->json.has("hard"));
+  EXPECT_TRUE(report_->json.at("hard").items.empty());
+  EXPECT_EQ(report_->json.at("hard_n").num, 0);
+  EXPECT_EQ(report_->result.out.find("hard scenes"), std::string::npos);
 }
 
 TEST_F(ReportRun, WritesThePng) {
   // gnuplot is a declared dependency (scripts/install-deps.sh): no skip.
-  ASSERT_TRUE(fs::exists(*dir_ / "report.png")) << "no PNG written; stderr: " << result_->err;
-  const std::string png = slurp(*dir_ / "report.png");
+  ASSERT_TRUE(fs::exists(report_->dir / "report.png")) << "no PNG written; stderr: " << report_->result.err;
+  const std::string png = slurp(report_->dir / "report.png");
   ASSERT_GE(png.size(), 8U);
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_GT(png.size(), 10000U) << "suspiciously small plot";
 }
 
 TEST_F(ReportRun, SweepCoversTheRequestedSizes) {
-  ASSERT_TRUE(json_->has("sweep"));
+  ASSERT_TRUE(report_->json.has("sweep"));
   std::set<std::pair<std::string, double>> points;
-  for (const Json& p : json_->at("sweep").items) {
+  for (const Json& p : report_->json.at("sweep").items) {
     EXPECT_GT(p.at("collisions_per_second").num, 0);
     EXPECT_GT(p.at("bandwidth_fraction").num, 0);
     points.insert({p.at("model").str, p.at("n").num});

@@ -31,6 +31,7 @@
 #include "collide/model.hpp"
 #include "collide/reference.hpp"  // COLLIDE_HAS_FLOAT128
 #include "support/mini_json.hpp"
+#include "support/report_run.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
@@ -38,7 +39,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using collide::test::Json;
-using collide::test::JsonParser;
 using collide::test::RunResult;
 using collide::test::slurp;
 
@@ -47,42 +47,28 @@ constexpr std::size_t kHardN = 200;
 class HardReportRun : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = new fs::path(fs::path(COLLIDE_TEST_TMP) / "report-hard");
-    fs::remove_all(*dir_);
-    fs::create_directories(*dir_);
-    result_ = new RunResult(collide::test::run_program(
-        COLLIDE_CLI_PATH, *dir_,
-        {"report", "--quick", "--n", "2000", "--threads", "1", "--hard", "--hard-n", std::to_string(kHardN), "--json",
-         (*dir_ / "report.json").string(), "--plot", (*dir_ / "report.png").string()}));
-    json_ = new Json;
-    if (fs::exists(*dir_ / "report.json")) *json_ = JsonParser(slurp(*dir_ / "report.json")).parse();
+    report_ = collide::test::run_report(
+        COLLIDE_CLI_PATH, fs::path(COLLIDE_TEST_TMP) / "report-hard",
+        {"--quick", "--n", "2000", "--threads", "1", "--hard", "--hard-n", std::to_string(kHardN)});
   }
-  static void TearDownTestSuite() {
-    delete json_;
-    delete result_;
-    delete dir_;
-  }
-  static const std::vector<Json>& hard() { return json_->at("hard").items; }
+  static void TearDownTestSuite() { report_.reset(); }
+  static const std::vector<Json>& hard() { return report_->json.at("hard").items; }
 
-  static fs::path* dir_;
-  static RunResult* result_;
-  static Json* json_;
+  static std::unique_ptr<const collide::test::ReportOutput> report_;
 };
-fs::path* HardReportRun::dir_ = nullptr;
-RunResult* HardReportRun::result_ = nullptr;
-Json* HardReportRun::json_ = nullptr;
+std::unique_ptr<const collide::test::ReportOutput> HardReportRun::report_;
 
 std::string trace(const Json& row) {
   return row.at("family").str + " " + row.at("model").str + " " + row.at("precision").str + " " + row.at("mode").str;
 }
 
 TEST_F(HardReportRun, ExitsZeroAndPrintsTheSection) {
-  ASSERT_EQ(result_->exit_code, 0) << result_->err;
-  const std::size_t start = result_->out.find("hard scenes (--hard");
-  ASSERT_NE(start, std::string::npos) << result_->out;
-  ASSERT_TRUE(json_->has("hard"));
+  ASSERT_EQ(report_->result.exit_code, 0) << report_->result.err;
+  const std::size_t start = report_->result.out.find("hard scenes (--hard");
+  ASSERT_NE(start, std::string::npos) << report_->result.out;
+  ASSERT_TRUE(report_->json.has("hard"));
   // One table line per hard row, in the JSON's order.
-  std::istringstream table(result_->out.substr(start));
+  std::istringstream table(report_->result.out.substr(start));
   std::string line;
   std::size_t next = 0;
   while (std::getline(table, line) && next < hard().size()) {
@@ -96,8 +82,8 @@ TEST_F(HardReportRun, ExitsZeroAndPrintsTheSection) {
 }
 
 TEST_F(HardReportRun, OneRowPerCatalogueScenePrecisionAndMode) {
-  ASSERT_TRUE(json_->has("hard"));
-  EXPECT_EQ(json_->at("hard_n").num, static_cast<double>(kHardN));
+  ASSERT_TRUE(report_->json.has("hard"));
+  EXPECT_EQ(report_->json.at("hard_n").num, static_cast<double>(kHardN));
   using Key = std::tuple<std::string, std::string, std::string, std::string>;
   std::map<Key, int> seen;
   for (const Json& row : hard()) {
@@ -118,7 +104,7 @@ TEST_F(HardReportRun, OneRowPerCatalogueScenePrecisionAndMode) {
 }
 
 TEST_F(HardReportRun, SpeedsAndSizesAreSane) {
-  ASSERT_TRUE(json_->has("hard"));
+  ASSERT_TRUE(report_->json.has("hard"));
   for (const Json& row : hard()) {
     SCOPED_TRACE(trace(row));
     EXPECT_GT(row.at("collisions_per_second").num, 0);
@@ -135,7 +121,7 @@ TEST_F(HardReportRun, SpeedsAndSizesAreSane) {
 }
 
 TEST_F(HardReportRun, FastRowsWithinTheTargetAccurateRowsWithinTheirUlps) {
-  ASSERT_TRUE(json_->has("hard"));
+  ASSERT_TRUE(report_->json.has("hard"));
   std::size_t fast = 0, accurate = 0;
   for (const Json& row : hard()) {
     SCOPED_TRACE(trace(row));
@@ -170,7 +156,7 @@ TEST_F(HardReportRun, GrazingShowsWhyTheAccurateModeExists) {
   // error is orders of magnitude above the accurate mode's bound. The fast
   // particle kernel forms vn and jn in double lanes (float) or compensated
   // (double) and rounds jn once, so it is within the bound there too.
-  ASSERT_TRUE(json_->has("hard"));
+  ASSERT_TRUE(report_->json.has("hard"));
   std::size_t checked = 0;
   for (const Json& row : hard()) {
     if (row.at("family").str != "grazing" || row.at("mode").str != "fast") continue;
@@ -189,8 +175,8 @@ TEST_F(HardReportRun, GrazingShowsWhyTheAccurateModeExists) {
 TEST_F(HardReportRun, ThePngHasTheHardPanel) {
   // gnuplot is a declared dependency: no skip. Three panels: 2400 px wide
   // (two panels are 1600), read from the PNG's IHDR chunk.
-  ASSERT_TRUE(fs::exists(*dir_ / "report.png")) << result_->err;
-  const std::string png = slurp(*dir_ / "report.png");
+  ASSERT_TRUE(fs::exists(report_->dir / "report.png")) << report_->result.err;
+  const std::string png = slurp(report_->dir / "report.png");
   ASSERT_GE(png.size(), 24U);
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   const auto byte = [&](std::size_t i) { return static_cast<unsigned>(static_cast<unsigned char>(png[i])); };
