@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -49,19 +50,26 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
   const collide::ImpulseView<T>& j = impulses;
   Record* bodies = records.bodies;
   arena.execute([&] {
-    // As the kernel (kernel_isa.cpp, solve_groups): the records and the
-    // contact's own lines (its fields and J) are requested kAhead contacts
-    // ahead.
-    auto prefetch = [&](std::size_t p) {
+    // As the kernel (kernel_isa.cpp, solve_groups): a contact's own lines
+    // (its body indices, fields and J) are requested 2 kAhead contacts
+    // ahead, its records kAhead ahead (reading the indices the first
+    // request brought in, not missing on them).
+    auto prefetch_contact = [&](std::size_t p) {
       const std::uint32_t k = order[p];
-      for (const std::uint32_t i : {c.a[k], c.b[k]}) {
-        const char* r = reinterpret_cast<const char*>(bodies + i);
-        for (std::size_t off = 0; off < sizeof(Record); off += 64) __builtin_prefetch(r + off, 0, 2);
-      }
+      __builtin_prefetch(c.a + k, 0, 2);
+      __builtin_prefetch(c.b + k, 0, 2);
       for (const T* f : {c.c.x, c.c.y, c.c.z, c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
       if (c.e != nullptr) __builtin_prefetch(c.e + k, 0, 2);
       if (c.mu != nullptr) __builtin_prefetch(c.mu + k, 0, 2);
       for (T* f : {j.j.x, j.j.y, j.j.z}) __builtin_prefetch(f + k, 1, 2);
+    };
+    auto prefetch_records = [&](std::size_t p) {
+      const std::uint32_t k = order[p];
+      for (const std::uint32_t i : {c.a[k], c.b[k]}) {
+        const char* r = reinterpret_cast<const char*>(bodies + i);
+        for (std::size_t off = 0; off < sizeof(Record); off += 64) __builtin_prefetch(r + off, 0, 2);
+        if constexpr (std::is_same_v<Record, collide::PackedRigid<T>>) __builtin_prefetch(records.inv_mass + i, 0, 2);
+      }
     };
     auto run = [&](std::size_t begin, std::size_t end) {
       // The records are read as 16-byte rows into one accumulator per row
@@ -71,9 +79,11 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
       // slower than the kernel it is meant to bound.)
       Row acc[kRows] = {};
       Record spare{};
-      for (std::size_t p = begin; p < std::min(end, begin + kAhead); ++p) prefetch(p);
+      for (std::size_t p = begin; p < std::min(end, begin + 2 * kAhead); ++p) prefetch_contact(p);
+      for (std::size_t p = begin; p < std::min(end, begin + kAhead); ++p) prefetch_records(p);
       for (std::size_t p = begin; p < end; ++p) {
-        if (p + kAhead < end) prefetch(p + kAhead);
+        if (p + 2 * kAhead < end) prefetch_contact(p + 2 * kAhead);
+        if (p + kAhead < end) prefetch_records(p + kAhead);
         const std::uint32_t k = order[p];
         Record& a = bodies[c.a[k]];
         Record& b = bodies[c.b[k]];
@@ -92,8 +102,8 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
         // Stores of an immovable body go to a record of this thread's own
         // (a select, not a branch: the ground side is random, and a
         // mispredicted branch would drop the loads in flight behind it).
-        T* wa = a.inv_mass != 0 ? va : reinterpret_cast<T*>(&spare);
-        T* wb = b.inv_mass != 0 ? vb : reinterpret_cast<T*>(&spare);
+        T* wa = collide::packed_inv_mass(records, c.a[k]) != 0 ? va : reinterpret_cast<T*>(&spare);
+        T* wb = collide::packed_inv_mass(records, c.b[k]) != 0 ? vb : reinterpret_cast<T*>(&spare);
         for (std::size_t f = 0; f < kWritten; ++f) wa[f] = va[f] + zero * sum;
         for (std::size_t f = 0; f < kWritten; ++f) wb[f] = vb[f] - zero * sum;
         j.j.x[k] = zero * sum, j.j.y[k] = zero * sum, j.j.z[k] = zero * sum;

@@ -4,10 +4,11 @@
 //
 // It does what Solver::solve does on the caller's packed records, minus the
 // law: the batches run one after another with blocks of 1024 contacts over
-// TBB, each contact is read through the schedule's order with its two
-// records and its own lines prefetched the same distance ahead, every value
-// of both records (as 16-byte rows) and of the contact is read, v (and w) of the movable
-// bodies and J are written (one add of a multiple of zero per value instead
+// TBB, each contact is read through the schedule's order with its own lines
+// prefetched twice as far ahead as its two records (as the kernel does),
+// every value of both records (as 16-byte rows; a rigid body's inverse mass
+// from the view's array) and of the contact is read, v (and w) of the
+// movable bodies and J are written (one add of a multiple of zero per value instead
 // of the law). Kernel throughput over twin throughput is the fraction of the
 // layout's own ceiling that the arithmetic leaves.
 #pragma once

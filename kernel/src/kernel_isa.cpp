@@ -154,8 +154,8 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
       });
     }
   } else {
-    read_records<M, V>(bodies.bodies, ia, a);
-    read_records<M, V>(bodies.bodies, ib, b);
+    read_records<M, V>(bodies, ia, a);
+    read_records<M, V>(bodies, ib, b);
   }
 
   ContactLanes<V> c;
@@ -191,8 +191,8 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
   } else {
     // a's records first, then b's: within a group no movable body repeats,
     // so the order of the stores cannot matter.
-    write_records<M, V>(bodies.bodies, ia, a, movable_a);
-    write_records<M, V>(bodies.bodies, ib, b, movable_b);
+    write_records<M, V>(bodies, ia, a, movable_a);
+    write_records<M, V>(bodies, ib, b, movable_b);
   }
   if (g.contiguous) {
     store(r.j.x, impulses.j.x + g.first);
@@ -249,8 +249,8 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
         }
       }
       for (std::size_t k = begin; k < std::min(end, begin + kPrefetchAhead); ++k) {
-        prefetch_record(bodies.bodies, contacts.a[order[k]]);
-        prefetch_record(bodies.bodies, contacts.b[order[k]]);
+        prefetch_record(bodies, contacts.a[order[k]]);
+        prefetch_record(bodies, contacts.b[order[k]]);
       }
       for (; i + W <= end; i += W) {
         if (!contiguous) {
@@ -259,8 +259,8 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
           }
         }
         for (std::size_t k = i + kPrefetchAhead; k < std::min(end, i + W + kPrefetchAhead); ++k) {
-          prefetch_record(bodies.bodies, contacts.a[order[k]]);
-          prefetch_record(bodies.bodies, contacts.b[order[k]]);
+          prefetch_record(bodies, contacts.a[order[k]]);
+          prefetch_record(bodies, contacts.b[order[k]]);
         }
         solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses,
                                               ContactGroup{contiguous, order[i], order + i});

@@ -52,7 +52,7 @@ void unpack_velocities_of(const PackedView<Record>& from, const View& to) {
   check_counts(from.count, to.count, "collide::unpack_velocities");
   for_bodies(from.count, [&](std::size_t i) {
     const Record& r = from.bodies[i];
-    if (r.inv_mass == T(0)) return;
+    if (packed_inv_mass(from, i) == T(0)) return;
     put3(to.v, r.v, i);
     if constexpr (!std::is_same_v<Record, PackedParticle<T>>) put3(to.w, r.w, i);
   });
@@ -67,7 +67,9 @@ void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_cons
     auto& r = to.bodies[i];
     get3(r.v, from.v, i), get3(r.w, from.w, i), get3(r.p, from.p, i);
     r.q[0] = from.q.w[i], r.q[1] = from.q.x[i], r.q[2] = from.q.y[i], r.q[3] = from.q.z[i];
-    r.inv_mass = from.inv_mass[i];
+    // The solver packs SoA input with the caller's inverse masses as the
+    // view's own: nothing to copy then.
+    if (to.inv_mass != from.inv_mass) to.inv_mass[i] = from.inv_mass[i];
     r.inv_inertia[0] = from.inv_inertia.x[i], r.inv_inertia[1] = from.inv_inertia.y[i];
     r.inv_inertia[2] = from.inv_inertia.z[i];
   });
@@ -101,7 +103,7 @@ void unpack(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
     const auto& r = from.bodies[i];
     put3(to.v, r.v, i), put3(to.w, r.w, i), put3(to.p, r.p, i);
     to.q.w[i] = r.q[0], to.q.x[i] = r.q[1], to.q.y[i] = r.q[2], to.q.z[i] = r.q[3];
-    to.inv_mass[i] = r.inv_mass;
+    to.inv_mass[i] = from.inv_mass[i];
     to.inv_inertia.x[i] = r.inv_inertia[0], to.inv_inertia.y[i] = r.inv_inertia[1];
     to.inv_inertia.z[i] = r.inv_inertia[2];
   });

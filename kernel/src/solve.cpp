@@ -279,7 +279,12 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
     return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
   }
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
-  const PackedView<Record> packed{bodies.count, impl_->buffer<Record>().reserve(bodies.count)};
+  PackedView<Record> packed;
+  packed.count = bodies.count;
+  packed.bodies = impl_->buffer<Record>().reserve(bodies.count);
+  // A rigid view's inverse masses are the caller's own array: the kernels
+  // only read them, so they are not copied.
+  if constexpr (std::is_same_v<Record, PackedRigid<T>>) packed.inv_mass = bodies.inv_mass;
   impl_->arena->execute([&] { pack(bodies, packed); });
   job.packed = true;
   detail::set_packed(job, packed);

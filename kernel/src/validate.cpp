@@ -106,7 +106,9 @@ std::vector<BodyField<T>> fields_of(const PackedView<PackedRigid<T>>& b) {
   const PackedFields<PackedRigid<T>> f;
   const PackedRigid<T>* r = b.bodies;
   if (r == nullptr) return null_records<T>();
-  return {f("inv_mass", &r->inv_mass, true),
+  if (b.inv_mass == nullptr) return {{"inv_mass", nullptr, true, 1}};
+  // The inverse masses are the view's own array (collide/packed.hpp).
+  return {{"inv_mass", b.inv_mass, true, 1},
           f("inv_inertia.x", &r->inv_inertia[0], true),
           f("inv_inertia.y", &r->inv_inertia[1], true),
           f("inv_inertia.z", &r->inv_inertia[2], true),
@@ -366,6 +368,7 @@ bool screen_records(const PackedView<Record>& b,
   std::array<M, kVectors> inverse{};
   const T* base = &b.bodies[0].v[0];
   for (const BodyField<T>& f : fields) {
+    if (f.stride != sizeof(Record) / sizeof(T)) continue;  // not in the record (a rigid view's inv_mass)
     const auto at = static_cast<std::size_t>(f.data - base);
     used[at / S::kLanes][at % S::kLanes] = -1;
     if (f.inverse) inverse[at / S::kLanes][at % S::kLanes] = -1;
@@ -385,6 +388,7 @@ template <class T>
 bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<BodyField<T>>& fields, std::size_t i0,
                    std::size_t i1) {
   if (!screen_records(b, fields, i0, i1)) return false;
+  if (!screen_values(b.inv_mass + i0, i1 - i0, true)) return false;
   std::uint64_t bad = 0;
   for (std::size_t i = i0; i < i1; ++i) {
     const T* q = b.bodies[i].q;

@@ -26,7 +26,7 @@ template <class Record>
 bool same_record_bytes(const Record& x, const Record& y) {
   // Only the values: the padding of a record is not part of the layout.
   using T = typename PackedValue<Record>::type;
-  constexpr std::size_t values = std::is_same_v<Record, PackedRigid<T>>    ? 17
+  constexpr std::size_t values = std::is_same_v<Record, PackedRigid<T>>    ? 16
                                  : std::is_same_v<Record, PackedSphere<T>> ? 11
                                                                            : 4;
   return std::memcmp(&x, &y, values * sizeof(T)) == 0;
@@ -56,6 +56,8 @@ void expect_round_trip() {
     PackedBuffer<PackedRigid<T>> again(from.count);
     pack(std::as_const(original).view(), packed_view(again));
     for (std::size_t i = 0; i < from.count; ++i) ASSERT_TRUE(same_record_bytes(packed[i], again[i])) << i;
+    EXPECT_EQ(0, std::memcmp(packed.inv_mass.data(), from.inv_mass, from.count * sizeof(T)));
+    EXPECT_EQ(packed.inv_mass, again.inv_mass);
   }
   {
     PackedBuffer<PackedSphere<T>> packed(from.count);
@@ -79,7 +81,7 @@ void expect_round_trip() {
   {
     PackedBuffer<PackedRigid<T>> packed(from.count);
     pack(from, packed_view(packed));
-    for (auto& r : packed) r.v[0] = T(42), r.w[2] = T(-42), r.p[1] = T(1e9);
+    for (auto& r : packed.bodies) r.v[0] = T(42), r.w[2] = T(-42), r.p[1] = T(1e9);
     BodyBuffer<T> back = original;
     unpack_velocities(packed_view(packed), back.view());
     const BodyView<T> b = back.view();
@@ -102,9 +104,14 @@ TEST(PackedLayout, RoundTripIsExactDouble) { expect_round_trip<double>(); }
 TEST(PackedLayout, RecordsAreAlignedAndSized) {
   PackedBuffer<PackedRigid<float>> r(3);
   PackedBuffer<PackedParticle<double>> p(5);
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(r.data()) % 64, 0u);
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p.data()) % 32, 0u);
-  EXPECT_EQ(sizeof(PackedRigid<float>), 128u);
+  PackedBuffer<PackedRigid<double>> rd(3);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(r.bodies.data()) % 64, 0u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(rd.bodies.data()) % 128, 0u);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(p.bodies.data()) % 32, 0u);
+  // One line per rigid float body, two per double: the inverse mass is beside the records.
+  EXPECT_EQ(sizeof(PackedRigid<float>), 64u);
+  EXPECT_EQ(sizeof(PackedRigid<double>), 128u);
+  EXPECT_EQ(r.inv_mass.size(), 3u);
   EXPECT_EQ(sizeof(PackedSphere<float>), 64u);
   EXPECT_EQ(sizeof(PackedParticle<float>), 16u);
 }

@@ -277,9 +277,15 @@ TYPED_TEST(Validate, PackedRecordsGetTheVerdictOfTheirSoAView) {
   Fixture<T> f;
   const PackedView<PackedRigid<T>> none{f.bodies.count, nullptr};
   EXPECT_NE(validate(none, f.contacts, f.impulses).message.find("bodies.records is null"), std::string::npos);
+  PackedBuffer<PackedRigid<T>> rigid(f.bodies.count);
+  pack(f.bodies, packed_view(rigid));
+  const PackedView<PackedRigid<T>> no_masses{f.bodies.count, rigid.bodies.data(), nullptr};
+  EXPECT_NE(validate(no_masses, f.contacts, f.impulses).message.find("bodies.inv_mass is null"), std::string::npos);
 }
 
-// The kernels never read a record's padding: NaN there is not an error.
+// The kernels never read a record's padding: NaN there is not an error. (A
+// rigid record has none: 16 values, its inverse mass beside it; its values
+// and the inverse masses are each screened where they are.)
 TYPED_TEST(Validate, PackedPaddingIsNotRead) {
   using T = TypeParam;
   Fixture<T> f;
@@ -287,19 +293,20 @@ TYPED_TEST(Validate, PackedPaddingIsNotRead) {
   PackedBuffer<PackedSphere<T>> sphere(f.bodies.count);
   pack(f.bodies, packed_view(rigid));
   pack(sphere_view(f.bodies), packed_view(sphere));
-  const auto poison = [](auto& records, std::size_t used) {
-    for (auto& r : records) {
-      T* x = &r.v[0];
-      for (std::size_t k = used; k < sizeof(r) / sizeof(T); ++k) x[k] = std::numeric_limits<T>::quiet_NaN();
-    }
-  };
-  poison(rigid, 17);
-  poison(sphere, 11);
-  EXPECT_TRUE(validate(packed_view(rigid), f.contacts, f.impulses))
-      << validate(packed_view(rigid), f.contacts, f.impulses).message;
-  EXPECT_TRUE(validate(packed_view(sphere), f.contacts, f.impulses));
+  static_assert(sizeof(PackedRigid<T>) == 16 * sizeof(T));
+  for (auto& r : sphere.bodies) {
+    T* x = &r.v[0];
+    for (std::size_t k = 11; k < sizeof(r) / sizeof(T); ++k) x[k] = std::numeric_limits<T>::quiet_NaN();
+  }
+  EXPECT_TRUE(validate(packed_view(sphere), f.contacts, f.impulses))
+      << validate(packed_view(sphere), f.contacts, f.impulses).message;
+  EXPECT_TRUE(validate(packed_view(rigid), f.contacts, f.impulses));
   rigid[7].inv_inertia[2] = -1;
   EXPECT_NE(validate(packed_view(rigid), f.contacts, f.impulses).message.find("bodies.inv_inertia.z[7]"),
+            std::string::npos);
+  rigid[7].inv_inertia[2] = 1;
+  rigid.inv_mass[5] = std::numeric_limits<T>::quiet_NaN();
+  EXPECT_NE(validate(packed_view(rigid), f.contacts, f.impulses).message.find("bodies.inv_mass[5]"),
             std::string::npos);
 }
 

@@ -16,15 +16,23 @@
 // divides it), so no record straddles more lines than it must:
 //
 //   record               float            double
-//   PackedRigid<T>       128 B (2 lines)  192 B (3 lines)   17 values
+//   PackedRigid<T>       64 B (1 line)    128 B (2 lines)   16 values + inv_mass
 //   PackedSphere<T>      64 B (1 line)    128 B (2 lines)   11 values
 //   PackedParticle<T>    16 B (4/line)    32 B (2/line)      4 values
 //
 // v and w come first, so the values the kernel writes share the first line.
-// Rigid float needs 68 bytes, 4 more than a line: its second line holds the
-// last inverse moment alone. (A read-only/read-write split into two arrays
-// touches two lines per body as well; one record keeps the two lines
-// adjacent, where the hardware's adjacent-line prefetch fetches both.)
+//
+// A rigid body has 17 values, one more than a float line holds. Its inverse
+// mass therefore lives beside the records, in a dense array of its own
+// (PackedView<PackedRigid<T>>::inv_mass), and the record holds the other 16:
+// one line per body in float, two in double, instead of two and three. The
+// number of lines per body is what this path costs: on this project's
+// machine (AMD EPYC Zen 4, 2 threads, 2M bodies, 4M random contacts) a
+// memory-only loop over one-line records with the dense inverse-mass array
+// ran at 85 M contacts/s, over two-line records at 62, over three-line
+// records at 31 (docs/collision-law.md, "The packed layout"). The dense
+// array is 4 or 8 bytes per body, so it stays in the caches far better than
+// the records it serves; the schedule reads it in one stream.
 //
 // The layout holds the same values as the SoA views, in the same units, and
 // converts to and from them exactly (a copy, no arithmetic): a caller may
@@ -42,14 +50,14 @@
 
 namespace collide {
 
-/// One rigid body, packed. Same meaning and units as BodyView.
+/// One rigid body, packed: everything but its inverse mass, which is in the
+/// view's dense inv_mass array (see above). Same meaning and units as BodyView.
 template <class T>
-struct alignas(64) PackedRigid {
+struct alignas(16 * sizeof(T)) PackedRigid {
   T v[3];            ///< linear velocity, world frame [m/s]; updated by the kernels
   T w[3];            ///< angular velocity, world frame [rad/s]; updated by the kernels
   T p[3];            ///< centre of mass, world frame [m]
   T q[4];            ///< orientation (w, x, y, z), unit, body frame to world frame
-  T inv_mass;        ///< [1/kg]; 0 = immovable
   T inv_inertia[3];  ///< inverse principal moments, body frame [1/(kg m^2)]
 };
 
@@ -70,28 +78,72 @@ struct alignas(4 * sizeof(T)) PackedParticle {
   T inv_mass;  ///< [1/kg]; 0 = immovable
 };
 
-static_assert(sizeof(PackedRigid<float>) == 128 && sizeof(PackedRigid<double>) == 192);
+static_assert(sizeof(PackedRigid<float>) == 64 && sizeof(PackedRigid<double>) == 128);
 static_assert(sizeof(PackedSphere<float>) == 64 && sizeof(PackedSphere<double>) == 128);
 static_assert(sizeof(PackedParticle<float>) == 16 && sizeof(PackedParticle<double>) == 32);
 static_assert(std::is_trivially_copyable_v<PackedRigid<float>> && std::is_standard_layout_v<PackedRigid<float>>);
 
-/// Non-owning view of `count` packed records. Record is PackedRigid<T>,
-/// PackedSphere<T> or PackedParticle<T>; the records must be aligned as the
-/// type says (std::vector<Record> is, since C++17).
+/// Non-owning view of `count` packed records. Record is PackedSphere<T> or
+/// PackedParticle<T> (PackedRigid<T> has its own view, below); the records
+/// must be aligned as the type says (std::vector<Record> is, since C++17).
 template <class Record>
 struct PackedView {
   std::size_t count = 0;
   Record* bodies = nullptr;
 };
 
-/// Owning storage for packed bodies: a std::vector, whose allocator honours
-/// the records' alignment.
+/// Non-owning view of `count` packed rigid bodies: the records and, beside
+/// them, the inverse masses.
+template <class T>
+struct PackedView<PackedRigid<T>> {
+  std::size_t count = 0;
+  PackedRigid<T>* bodies = nullptr;
+  T* inv_mass = nullptr;  ///< body i's inverse mass [1/kg] at inv_mass[i]; 0 = immovable. Never written by a solve.
+};
+
+/// Owning storage for `size()` packed bodies: std::vectors, whose allocator
+/// honours the records' alignment.
 template <class Record>
-using PackedBuffer = std::vector<Record>;
+struct PackedBuffer {
+  std::vector<Record> bodies;
+
+  PackedBuffer() = default;
+  explicit PackedBuffer(std::size_t count) : bodies(count) {}
+  [[nodiscard]] std::size_t size() const { return bodies.size(); }
+  void resize(std::size_t count) { bodies.resize(count); }
+  void push_back(const Record& body) { bodies.push_back(body); }
+  Record& operator[](std::size_t i) { return bodies[i]; }
+  const Record& operator[](std::size_t i) const { return bodies[i]; }
+};
+
+/// ... of rigid bodies, with their inverse masses.
+template <class T>
+struct PackedBuffer<PackedRigid<T>> {
+  std::vector<PackedRigid<T>> bodies;
+  std::vector<T> inv_mass;  ///< [1/kg]; 0 = immovable
+
+  PackedBuffer() = default;
+  explicit PackedBuffer(std::size_t count) : bodies(count), inv_mass(count) {}
+  [[nodiscard]] std::size_t size() const { return bodies.size(); }
+  void resize(std::size_t count) {
+    bodies.resize(count);
+    inv_mass.resize(count);
+  }
+  void push_back(const PackedRigid<T>& body, T body_inv_mass) {
+    bodies.push_back(body);
+    inv_mass.push_back(body_inv_mass);
+  }
+  PackedRigid<T>& operator[](std::size_t i) { return bodies[i]; }
+  const PackedRigid<T>& operator[](std::size_t i) const { return bodies[i]; }
+};
 
 template <class Record>
 PackedView<Record> packed_view(PackedBuffer<Record>& buffer) {
-  return {buffer.size(), buffer.data()};
+  return {buffer.size(), buffer.bodies.data()};
+}
+template <class T>
+PackedView<PackedRigid<T>> packed_view(PackedBuffer<PackedRigid<T>>& buffer) {
+  return {buffer.size(), buffer.bodies.data(), buffer.inv_mass.data()};
 }
 
 /// The value type of a packed record.
@@ -110,11 +162,24 @@ struct PackedValue<PackedParticle<T>> {
   using type = T;
 };
 
+/// Body i's inverse mass [1/kg] in a packed view: in the record, or for
+/// rigid bodies in the view's inv_mass array.
+template <class Record>
+typename PackedValue<Record>::type packed_inv_mass(const PackedView<Record>& view, std::size_t i) {
+  return view.bodies[i].inv_mass;
+}
+template <class T>
+T packed_inv_mass(const PackedView<PackedRigid<T>>& view, std::size_t i) {
+  return view.inv_mass[i];
+}
+
 // Conversions. Exact copies in both directions; `to.count` must equal
 // `from.count` (std::invalid_argument otherwise). Independent bodies are
 // converted in parallel in the calling thread's TBB arena.
 
-/// SoA to packed: every field. U is T or const T.
+/// SoA to packed: every field. U is T or const T. A rigid view whose
+/// inv_mass is the SoA's own array (the solver packs that way) leaves it as
+/// it is.
 template <class U>
 void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_const_t<U>>>& to);
 template <class U>

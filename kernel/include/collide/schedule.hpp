@@ -64,14 +64,18 @@ class Schedule {
     build_strided(contacts, body_count, inv_mass, 1, threads);
   }
   /// The same on packed records (collide/packed.hpp): the inverse masses are
-  /// read in place from the records, so a caller who keeps its bodies packed
-  /// needs no other copy of them.
+  /// read in place from the records (a rigid view's dense inv_mass array), so
+  /// a caller who keeps its bodies packed needs no other copy of them.
   template <class Record>
   void build(const ContactView<typename PackedValue<Record>::type>& contacts, const PackedView<Record>& bodies,
              int threads = 0) {
     using T = typename PackedValue<Record>::type;
     const T* inv_mass = bodies.count != 0 ? &bodies.bodies->inv_mass : nullptr;
     build_strided(contacts, bodies.count, inv_mass, sizeof(Record) / sizeof(T), threads);
+  }
+  template <class T>
+  void build(const ContactView<T>& contacts, const PackedView<PackedRigid<T>>& bodies, int threads = 0) {
+    build_strided(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass), 1, threads);
   }
 
   /// Number of contacts the schedule was built for.
