@@ -76,7 +76,8 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
 
     ``bodies`` may be :class:`Bodies` (structure of arrays) or
     :class:`PackedBodies` (records, solved in place; the record type is the
-    model). ``impacts=False`` skips the pass over J that counts the non-zero
+    model; rigid records' inverse masses are read from their ``inv_mass``
+    array beside them). ``impacts=False`` skips the pass over J that counts the non-zero
     impulses (``stats["impacts"]`` is then None): at a million contacts that
     pass costs 5 to 10% of a particle solve.
     """
@@ -179,19 +180,29 @@ def packed_dtype(model="rigid", dtype=_np.float32):
     """The NumPy structured dtype of one packed body of ``model`` ("rigid",
     "sphere" or "particle") in ``dtype``: the fields of the C++ record
     (collide/packed.hpp) at its offsets, padding included in the itemsize
-    (rigid 128/192 bytes, sphere 64/128, particle 16/32 in float32/float64).
-    Rigid fields: v, w, p (3,), q (4,) as (w, x, y, z), inv_mass, inv_inertia
-    (3,); sphere: v, w, p, inv_mass, inv_inertia (one moment); particle: v,
+    (rigid 64/128 bytes, sphere 64/128, particle 16/32 in float32/float64;
+    16, 16 and 4 values). Rigid fields: v, w, p (3,), q (4,) as (w, x, y, z),
+    inv_inertia (3,), no padding; a rigid body's inverse mass is not in its
+    record but in an (N,) array beside the records (``PackedBodies(records,
+    inv_mass=...)``), so that a float32 record is one 64-byte cache line.
+    Sphere: v, w, p, inv_mass, inv_inertia (one moment); particle: v,
     inv_mass."""
     return _collide.packed_dtype(model, dtype)
 
 
 def packed_empty(n, model="rigid", dtype=_np.float32, *, columns=False):
-    """A zeroed array of ``n`` records, aligned as the records must be (64
-    bytes for rigid and sphere, the record size for particle; NumPy alone
-    aligns to 16). A 1-D array of :func:`packed_dtype`, or with
-    ``columns=True`` an (n, k) array of ``dtype`` whose rows are the records
-    (k values each, padding included). Wrap it with :class:`PackedBodies`."""
+    """A zeroed array of ``n`` records, aligned as the records must be (the
+    record size for rigid (64 or 128 bytes) and particle, 64 bytes for
+    sphere; NumPy alone aligns to 16). A 1-D array of :func:`packed_dtype`,
+    or with ``columns=True`` an (n, k) array of ``dtype`` whose rows are the
+    records (k values each, padding included). Wrap it with
+    :class:`PackedBodies`. Rigid records also need their inverse masses
+    beside them, any C-contiguous (n,) array of ``dtype`` (NumPy's own
+    alignment suffices)::
+
+        records = collide.packed_empty(n, "rigid", numpy.float32)
+        packed = collide.PackedBodies(records, inv_mass=numpy.zeros(n, numpy.float32))
+    """
     record = _np.dtype(packed_dtype(model, dtype))
     align = _collide.packed_alignment(model, dtype)
     raw = _np.zeros(n * record.itemsize + align, dtype=_np.uint8)
@@ -205,12 +216,13 @@ def packed_empty(n, model="rigid", dtype=_np.float32, *, columns=False):
 def pack(bodies, model="rigid", *, contacts=None, columns=False):
     """Packs :class:`Bodies` into new aligned records (an exact copy of every
     field the record holds) and returns the :class:`PackedBodies`. Rigid
-    records hold everything. Sphere and particle records drop what their
-    model does not read, so they need the model to fit (ValueError with the
-    reason otherwise, as ``solve(..., model=...)``): whether the particle
-    model fits depends on the contacts, so "particle" and "auto" (the
-    cheapest model that fits, as :func:`solve` chooses; the inputs are
-    validated) need ``contacts``."""
+    records hold everything but the inverse masses, which are copied into a
+    new (N,) array beside them (``packed.inv_mass``). Sphere and particle
+    records drop what their model does not read, so they need the model to
+    fit (ValueError with the reason otherwise, as ``solve(..., model=...)``):
+    whether the particle model fits depends on the contacts, so "particle"
+    and "auto" (the cheapest model that fits, as :func:`solve` chooses; the
+    inputs are validated) need ``contacts``."""
     if not isinstance(bodies, Bodies):
         raise TypeError(f"pack: bodies must be collide.Bodies, got {type(bodies).__name__}")
     if model in ("auto", "particle") and contacts is None:
@@ -224,18 +236,21 @@ def pack(bodies, model="rigid", *, contacts=None, columns=False):
         misfit = _collide.model_misfit(bodies, contacts, model)
         if misfit:
             raise ValueError(f"pack: model '{model}' does not fit the scene: {misfit}")
-    packed = PackedBodies(packed_empty(len(bodies), model, bodies.dtype, columns=columns), model=model)
+    records = packed_empty(len(bodies), model, bodies.dtype, columns=columns)
+    inv_mass = _np.empty(len(bodies), bodies.dtype) if model == "rigid" else None
+    packed = PackedBodies(records, model=model, inv_mass=inv_mass)
     _collide.pack_into(bodies, packed)
     return packed
 
 
 def _unpack(self, into=None):
     """The records as :class:`Bodies`: an exact copy of every field the record
-    holds, into ``into`` (same count and dtype; its inv_mass, inv_inertia, q
-    and p must be writeable) or into new arrays, where the fields the record
-    does not hold are those of the same body in the rigid model: sphere
-    records give three equal moments and q = (1, 0, 0, 0); particle records
-    also give zero moments, p and w."""
+    holds (and of a rigid record's inverse mass beside it), into ``into``
+    (same count and dtype; its inv_mass, inv_inertia, q and p must be
+    writeable) or into new arrays, where the fields the record does not hold
+    are those of the same body in the rigid model: sphere records give three
+    equal moments and q = (1, 0, 0, 0); particle records also give zero
+    moments, p and w."""
     if into is None:
         n, dt = len(self), self.dtype
         q = _np.zeros((4, n), dtype=dt)
@@ -261,7 +276,8 @@ def _unpack_velocities(self, into):
 
 def _structured(self):
     """The records as a 1-D structured array of :func:`packed_dtype` (a view
-    of the same memory)."""
+    of the same memory; rigid records have no inv_mass field: see
+    ``inv_mass``)."""
     r = self.records
     if r.dtype.names is not None:
         return r
@@ -284,8 +300,18 @@ for _name, _doc in (
     ("w", "angular velocities (N, 3), a view (rigid and sphere records)"),
     ("p", "centres of mass (N, 3), a view (rigid and sphere records)"),
     ("q", "orientations (N, 4) as (w, x, y, z), a view (rigid records)"),
-    ("inv_mass", "inverse masses (N,), a view"),
     ("inv_inertia", "inverse moments, (N, 3) for rigid and (N,) for sphere records, a view"),
 ):
     setattr(PackedBodies, _name, _field(_name, _doc))
 del _name, _doc
+
+
+def _inv_mass(self):
+    """inverse masses (N,): for rigid records the array beside them (the one
+    given to the constructor, itself), for sphere and particle records a view
+    of the records"""
+    beside = self._inv_mass
+    return beside if beside is not None else _structured(self)["inv_mass"]
+
+
+PackedBodies.inv_mass = property(_inv_mass)

@@ -65,7 +65,12 @@ class PackedBodies:
     packed_dtype(model, dtype), or a C-contiguous (N, k) float array whose
     rows are the records; aligned as the record type says (packed_empty and
     pack allocate so). The record type is the model; v and w are updated in
-    place. The field properties are views of the records."""
+    place. The field properties are views of the records. Rigid records hold
+    no inverse mass: ``inv_mass`` (required for rigid records, refused for
+    sphere and particle records) is a C-contiguous (N,) array of their dtype
+    beside them, kept (no copy) and only read by a solve. Float records of
+    16 values are rigid or sphere records: ``inv_mass`` given says rigid,
+    else ``model`` must."""
 
     records: npt.NDArray[Any]
     model: Literal["rigid", "sphere", "particle"]
@@ -78,7 +83,13 @@ class PackedBodies:
     q: FloatArray
     inv_mass: FloatArray
     inv_inertia: FloatArray
-    def __init__(self, records: npt.NDArray[Any], *, model: ModelName = "auto") -> None: ...
+    def __init__(
+        self,
+        records: npt.NDArray[Any],
+        *,
+        model: ModelName = "auto",
+        inv_mass: FloatArray | None = None,
+    ) -> None: ...
     def __len__(self) -> int: ...
     def unpack(self, into: Bodies | None = None) -> Bodies: ...
     def unpack_velocities(self, into: Bodies) -> Bodies: ...

@@ -22,6 +22,9 @@
 //   checked for dtype, width, contiguity and alignment (TypeError) and
 //   solved in place by the library's packed overloads; values are checked by
 //   validate() for packed views, so records and SoA get the same messages.
+//   Rigid records hold no inverse mass: it is a second caller's array, (N,)
+//   beside the records (PackedView<PackedRigid<T>>::inv_mass), checked like
+//   any array argument and only read by the solve.
 // * The statistics dict is collide::solve_record (collide/check.hpp), the
 //   record `collide solve --stats` prints, and the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises.
@@ -350,7 +353,6 @@ std::vector<RecordField> record_fields(Model m) {
           {"w", offsetof(R, w), 3},
           {"p", offsetof(R, p), 3},
           {"q", offsetof(R, q), 4},
-          {"inv_mass", offsetof(R, inv_mass), 1},
           {"inv_inertia", offsetof(R, inv_inertia), 3}};
 }
 
@@ -381,58 +383,23 @@ constexpr std::array<Model, 3> kModels = {Model::rigid, Model::sphere, Model::pa
 /// N packed bodies over the caller's records, with no copy: a 1-D array of
 /// the record dtype (packed_dtype()), or a C-contiguous (N, k) float array
 /// whose rows are the records (k values of T per record, padding included).
-/// The record type is the model. v and w are updated in place.
+/// The record type is the model. v and w are updated in place. Rigid records
+/// hold no inverse mass (collide/packed.hpp): theirs is the caller's (N,)
+/// array `inv_mass`, beside them, which the solve only reads.
 struct PackedBodies {
   py::array records;
+  std::optional<py::array> inv_mass;  ///< rigid records only
   Model model = Model::rigid;
   Dtype dtype = Dtype::f32;
   std::size_t count = 0;
 
-  PackedBodies(const py::object& records_in, const std::string& model_name) {
+  PackedBodies(const py::object& records_in, const std::string& model_name, const py::object& inv_mass_in) {
     const std::string what = "packed.records";
     if (!py::isinstance<py::array>(records_in)) {
       throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(records_in)));
     }
     const auto a = py::reinterpret_borrow<py::array>(records_in);
-    const std::optional<Model> requested = parse_model(model_name);
-    const auto candidates = [&] {
-      return requested ? std::vector<Model>{*requested} : std::vector<Model>(kModels.begin(), kModels.end());
-    };
-    bool found = false;
-    if (a.dtype().kind() == 'V') {
-      for (const Dtype d : {Dtype::f32, Dtype::f64}) {
-        for (const Model m : candidates()) {
-          if (!found && a.dtype().equal(record_dtype(m, d))) {
-            found = true;
-            model = m;
-            dtype = d;
-          }
-        }
-      }
-      if (!found) {
-        throw py::type_error(what + " has dtype " + text(a.dtype()) + ", which is not " +
-                             (requested ? "collide.packed_dtype('" + model_name + "', float32 or float64)"
-                                        : std::string("a record dtype of collide.packed_dtype()")));
-      }
-      if (a.ndim() != 1) throw py::type_error(what + " has shape " + shape_text(a) + ", expected (N,) records");
-    } else {
-      dtype = scene_dtype(what, a);
-      const std::size_t t = dtype == Dtype::f32 ? sizeof(float) : sizeof(double);
-      std::string expected;
-      for (const Model m : candidates()) {
-        const std::size_t k = record_size(m, dtype) / t;
-        if (!found && a.ndim() == 2 && static_cast<std::size_t>(a.shape(1)) == k) {
-          found = true;
-          model = m;
-        }
-        expected +=
-            (expected.empty() ? "" : " or ") + std::string("(N, ") + std::to_string(k) + ") for " + to_string(m);
-      }
-      if (!found) {
-        throw py::type_error(what + " has shape " + shape_text(a) + ", expected " + expected + " records of " +
-                             dtype_name(dtype));
-      }
-    }
+    set_model(a, parse_model(model_name), model_name, !inv_mass_in.is_none());
     const int flags = a.flags();
     if ((flags & py::array::c_style) == 0) throw py::type_error(what + " must be C-contiguous");
     if ((flags & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) == 0) {
@@ -448,12 +415,112 @@ struct PackedBodies {
     records = a;
     count = static_cast<std::size_t>(a.shape(0));
     if (count > std::numeric_limits<BodyIndex>::max()) throw py::value_error("packed: more than 2^32 - 1 bodies");
+    if (model == Model::rigid) {
+      set_inv_mass(inv_mass_in);
+    } else if (!inv_mass_in.is_none()) {
+      throw py::type_error(std::string("packed.inv_mass is given, but ") + to_string(model) +
+                           " records hold their inverse masses: inv_mass= is for rigid records only");
+    }
+  }
+
+  /// Sets the model and dtype of the records `a`: the model whose record
+  /// dtype (structured) or record width (columns) it has, among `requested`
+  /// or all. Float records of 16 values are rigid or sphere records: a given
+  /// inv_mass says rigid (only rigid records take one), else the caller
+  /// must say (TypeError): guessing sphere for rigid records would solve
+  /// garbage.
+  void set_model(const py::array& a, const std::optional<Model>& requested, const std::string& model_name,
+                 bool has_inv_mass) {
+    const std::string what = "packed.records";
+    const std::vector<Model> candidates =
+        requested ? std::vector<Model>{*requested} : std::vector<Model>(kModels.begin(), kModels.end());
+    if (a.dtype().kind() == 'V') {
+      for (const Dtype d : {Dtype::f32, Dtype::f64}) {
+        for (const Model m : candidates) {
+          if (a.dtype().equal(record_dtype(m, d))) {
+            if (a.ndim() != 1) throw py::type_error(what + " has shape " + shape_text(a) + ", expected (N,) records");
+            dtype = d;
+            model = m;
+            return;
+          }
+        }
+      }
+      throw py::type_error(what + " has dtype " + text(a.dtype()) + ", which is not " +
+                           (requested ? "collide.packed_dtype('" + model_name + "', float32 or float64)"
+                                      : std::string("a record dtype of collide.packed_dtype()")));
+    }
+    dtype = scene_dtype(what, a);
+    const std::size_t t = dtype == Dtype::f32 ? sizeof(float) : sizeof(double);
+    std::vector<Model> matches;
+    std::vector<std::pair<std::size_t, std::string>> widths;  // values per record: the models of that width
+    for (const Model m : candidates) {
+      const std::size_t k = record_size(m, dtype) / t;
+      if (a.ndim() == 2 && static_cast<std::size_t>(a.shape(1)) == k) matches.push_back(m);
+      const auto same = std::find_if(widths.begin(), widths.end(), [&](const auto& w) { return w.first == k; });
+      if (same == widths.end()) {
+        widths.emplace_back(k, to_string(m));
+      } else {
+        same->second += std::string(" or ") + to_string(m);
+      }
+    }
+    if (matches.empty()) {
+      std::string expected;
+      for (const auto& [k, names] : widths) {
+        expected += (expected.empty() ? "" : " or ") + std::string("(N, ") + std::to_string(k) + ") for " + names;
+      }
+      throw py::type_error(what + " has shape " + shape_text(a) + ", expected " + expected + " records of " +
+                           dtype_name(dtype));
+    }
+    if (matches.size() == 1) {
+      model = matches.front();
+      return;
+    }
+    if (has_inv_mass && std::find(matches.begin(), matches.end(), Model::rigid) != matches.end()) {
+      model = Model::rigid;
+      return;
+    }
+    std::string names;
+    for (const Model m : matches) names += (names.empty() ? "" : " or ") + std::string(to_string(m));
+    throw py::type_error(what + " of shape " + shape_text(a) + " and dtype " + dtype_name(dtype) + " may be " + names +
+                         " records: say which with model=, or give rigid records their inv_mass=");
+  }
+
+  /// The rigid records' inverse masses: an (N,) array of their dtype, read
+  /// in place (checked like every array argument), and apart from the
+  /// records the solve writes.
+  void set_inv_mass(const py::object& inv_mass_in) {
+    if (inv_mass_in.is_none()) {
+      throw py::type_error(std::string("packed.inv_mass is missing: rigid records hold no inverse mass, it lives "
+                                       "beside them; give PackedBodies(records, inv_mass=...) a C-contiguous (N,) ") +
+                           dtype_name(dtype) + " array");
+    }
+    const py::array m =
+        checked_array("packed", "inv_mass", inv_mass_in, numpy_dtype(dtype), dtype_name(dtype), 0, false);
+    require_length("packed", "inv_mass", m, count, "packed.records");
+    const auto r0 = reinterpret_cast<std::uintptr_t>(records.data());
+    const auto m0 = reinterpret_cast<std::uintptr_t>(m.data());
+    const std::size_t t = dtype == Dtype::f32 ? sizeof(float) : sizeof(double);
+    if (count != 0 && m0 < r0 + count * record_size(model, dtype) && r0 < m0 + count * t) {
+      throw py::value_error(
+          "packed.inv_mass overlaps packed.records: the solve writes the records while it reads "
+          "the inverse masses");
+    }
+    inv_mass = m;
   }
 
   template <class Record>
   PackedView<Record> view() const {
-    return {count, data<Record>(records)};
+    using T = typename PackedValue<Record>::type;
+    PackedView<Record> v;
+    v.count = count;
+    v.bodies = data<Record>(records);
+    if constexpr (std::is_same_v<Record, PackedRigid<T>>) v.inv_mass = data<T>(*inv_mass);
+    return v;
   }
+
+  /// The inverse masses beside rigid records; None for sphere and particle
+  /// records, which hold theirs.
+  [[nodiscard]] py::object inv_mass_object() const { return inv_mass ? py::object(*inv_mass) : py::none(); }
 };
 
 template <class View>
@@ -503,6 +570,12 @@ void require_same_scene(const Bodies& bodies, const PackedBodies& packed) {
 /// Bodies into records (an exact copy): every field the record holds.
 void pack_into(const Bodies& bodies, const PackedBodies& packed) {
   require_same_scene(bodies, packed);
+  // Rigid inverse masses are copied into the side array, unless it is the
+  // bodies' own (library pack() leaves it then).
+  if (packed.inv_mass && packed.inv_mass->data() != bodies.inv_mass.data() &&
+      (packed.inv_mass->flags() & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) == 0) {
+    throw py::type_error("packed.inv_mass must be writeable to pack into it");
+  }
   const auto run = [&](auto tag) {
     using T = decltype(tag);
     const BodyView<T> bv = bodies.view<T>();
@@ -561,7 +634,7 @@ void require_same_dtype(const PackedBodies& bodies, const Contacts& contacts) {
 // The steps of a solve for each kind of bodies: SoA (Bodies) or packed.
 
 /// The schedule reads only the inverse masses (immovable bodies do not
-/// conflict); packed records give them in place.
+/// conflict); packed records give them in place (rigid ones beside them).
 template <class T>
 void build_schedule(Schedule& schedule, const ContactView<T>& cv, const Bodies& b) {
   schedule.build(cv, b.view<T>());
@@ -1091,9 +1164,12 @@ PYBIND11_MODULE(_collide, m) {
       .def("__len__", [](const Bodies& b) { return b.count; });
 
   py::class_<PackedBodies>(m, "PackedBodies")
-      .def(py::init<const py::object&, const std::string&>(), py::arg("records"), py::kw_only(),
-           py::arg("model") = "auto")
+      .def(py::init<const py::object&, const std::string&, const py::object&>(), py::arg("records"), py::kw_only(),
+           py::arg("model") = "auto", py::arg("inv_mass") = py::none())
       .def_readonly("records", &PackedBodies::records)
+      // The rigid records' side array, or None; collide.PackedBodies.inv_mass
+      // (__init__.py) gives every model's inverse masses.
+      .def_property_readonly("_inv_mass", &PackedBodies::inv_mass_object)
       .def_property_readonly("model", [](const PackedBodies& b) { return std::string(c::to_string(b.model)); })
       .def_property_readonly("dtype", [](const PackedBodies& b) { return numpy_dtype(b.dtype); })
       .def_property_readonly("record_dtype", [](const PackedBodies& b) { return record_dtype(b.model, b.dtype); })
