@@ -229,7 +229,7 @@ World make_world(const Options& o) {
       // A particle has no rotational state: infinite moment, inverse 0.
       const double moment = pass == 0 ? 0.4 * m * r * r : inf;
       world.add(m, moment, r, x, y, z);
-      Body& body = world.bodies.back();
+      Body& body = world.bodies.bodies.back();
       body.v[0] = static_cast<Real>(0.5 * (unit(rng) - 0.5));
       body.v[1] = static_cast<Real>(0.5 * (unit(rng) - 0.5));
     }
