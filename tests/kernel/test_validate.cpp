@@ -306,8 +306,7 @@ TYPED_TEST(Validate, PackedPaddingIsNotRead) {
             std::string::npos);
   rigid[7].inv_inertia[2] = 1;
   rigid.inv_mass[5] = std::numeric_limits<T>::quiet_NaN();
-  EXPECT_NE(validate(packed_view(rigid), f.contacts, f.impulses).message.find("bodies.inv_mass[5]"),
-            std::string::npos);
+  EXPECT_NE(validate(packed_view(rigid), f.contacts, f.impulses).message.find("bodies.inv_mass[5]"), std::string::npos);
 }
 
 }  // namespace
