@@ -31,6 +31,7 @@ struct RowOf<double> {
 };
 constexpr std::size_t kAhead = 32;  // contacts; as the kernel (COLLIDE_PREFETCH_AHEAD)
 constexpr std::size_t kBlock = 1024;
+constexpr std::size_t kGroup = 16;  // contacts whose loads precede their stores: the kernel's float lanes on AVX-512
 }  // namespace
 
 template <class Record>
@@ -73,40 +74,65 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
     };
     auto run = [&](std::size_t begin, std::size_t end) {
       // The records are read as 16-byte rows into one accumulator per row
-      // (both lines of a two-line record, as the kernel's row loads): short,
+      // (every line of the record, as the kernel's row loads): short,
       // independent add chains of vector adds, so the loop waits on memory
       // and not on arithmetic. (A scalar sum over the values made the twin
       // slower than the kernel it is meant to bound.)
+      //
+      // Contacts go in groups of kGroup, as the kernel's lanes: every load
+      // of a group (indices, fields, both records, the inverse masses) comes
+      // before its stores. Contact by contact, each store's address waited
+      // on an inverse-mass load and the next contact's loads queued behind
+      // it: that twin ran at half the kernel's speed, no ceiling.
       Row acc[kRows] = {};
       Record spare{};
       for (std::size_t p = begin; p < std::min(end, begin + 2 * kAhead); ++p) prefetch_contact(p);
       for (std::size_t p = begin; p < std::min(end, begin + kAhead); ++p) prefetch_records(p);
-      for (std::size_t p = begin; p < end; ++p) {
-        if (p + 2 * kAhead < end) prefetch_contact(p + 2 * kAhead);
-        if (p + kAhead < end) prefetch_records(p + kAhead);
-        const std::uint32_t k = order[p];
-        Record& a = bodies[c.a[k]];
-        Record& b = bodies[c.b[k]];
-        T sum = c.c.x[k] + c.c.y[k] + c.c.z[k] + c.n.x[k] + c.n.y[k] + c.n.z[k];
-        if (c.e) sum += c.e[k];
-        if (c.mu) sum += c.mu[k];
-        const auto* ra = reinterpret_cast<const Row*>(&a);
-        const auto* rb = reinterpret_cast<const Row*>(&b);
-        for (std::size_t r = 0; r < kRows; ++r) acc[r] += ra[r] + rb[r];
-        // The record's values, v first (collide/packed.hpp: standard layout,
-        // the values contiguous from offset 0).
-        T* va = reinterpret_cast<T*>(&a);
-        T* vb = reinterpret_cast<T*>(&b);
-        // As the kernel: v and w of movable bodies only (the ground body is
-        // in a quarter of the contacts and is never written).
-        // Stores of an immovable body go to a record of this thread's own
-        // (a select, not a branch: the ground side is random, and a
-        // mispredicted branch would drop the loads in flight behind it).
-        T* wa = collide::packed_inv_mass(records, c.a[k]) != 0 ? va : reinterpret_cast<T*>(&spare);
-        T* wb = collide::packed_inv_mass(records, c.b[k]) != 0 ? vb : reinterpret_cast<T*>(&spare);
-        for (std::size_t f = 0; f < kWritten; ++f) wa[f] = va[f] + zero * sum;
-        for (std::size_t f = 0; f < kWritten; ++f) wb[f] = vb[f] - zero * sum;
-        j.j.x[k] = zero * sum, j.j.y[k] = zero * sum, j.j.z[k] = zero * sum;
+      for (std::size_t g = begin; g < end; g += kGroup) {
+        const std::size_t n = std::min(kGroup, end - g);
+        for (std::size_t p = g + 2 * kAhead; p < std::min(end, g + n + 2 * kAhead); ++p) prefetch_contact(p);
+        for (std::size_t p = g + kAhead; p < std::min(end, g + n + kAhead); ++p) prefetch_records(p);
+        T* write_a[kGroup];
+        T* write_b[kGroup];
+        T sum[kGroup];
+        std::uint32_t contact[kGroup];
+        for (std::size_t l = 0; l < n; ++l) {
+          const std::uint32_t k = order[g + l];
+          const std::uint32_t ia = c.a[k];
+          const std::uint32_t ib = c.b[k];
+          contact[l] = k;
+          T x = c.c.x[k] + c.c.y[k] + c.c.z[k] + c.n.x[k] + c.n.y[k] + c.n.z[k];
+          if (c.e) x += c.e[k];
+          if (c.mu) x += c.mu[k];
+          sum[l] = x;
+          const auto* ra = reinterpret_cast<const Row*>(bodies + ia);
+          const auto* rb = reinterpret_cast<const Row*>(bodies + ib);
+          for (std::size_t r = 0; r < kRows; ++r) acc[r] += ra[r] + rb[r];
+          // As the kernel: v and w of movable bodies only (the ground body
+          // is in a quarter of the contacts and is never written). Stores of
+          // an immovable body go to a record of this thread's own (a select,
+          // not a branch: the ground side is random). The values are the
+          // record's, v first (collide/packed.hpp: standard layout).
+          write_a[l] = collide::packed_inv_mass(records, ia) != 0 ? reinterpret_cast<T*>(bodies + ia)
+                                                                  : reinterpret_cast<T*>(&spare);
+          write_b[l] = collide::packed_inv_mass(records, ib) != 0 ? reinterpret_cast<T*>(bodies + ib)
+                                                                  : reinterpret_cast<T*>(&spare);
+        }
+        // v and w (or v) are the first kWritten values: written as whole
+        // 16-byte rows, as the kernel writes a record with one masked row
+        // store (the row's other values are rewritten unchanged: within a
+        // batch no other contact touches a movable body; adding zero keeps
+        // every finite value but -0).
+        constexpr std::size_t kWrittenRows = (kWritten * sizeof(T) + sizeof(Row) - 1) / sizeof(Row);
+        for (std::size_t l = 0; l < n; ++l) {
+          const T d = zero * sum[l];
+          Row* ra = reinterpret_cast<Row*>(write_a[l]);
+          Row* rb = reinterpret_cast<Row*>(write_b[l]);
+          for (std::size_t r = 0; r < kWrittenRows; ++r) ra[r] += d;
+          for (std::size_t r = 0; r < kWrittenRows; ++r) rb[r] -= d;
+          const std::uint32_t k = contact[l];
+          j.j.x[k] = d, j.j.y[k] = d, j.j.z[k] = d;
+        }
       }
       Row total = {};
       for (const Row& x : acc) total += x;
