@@ -25,14 +25,19 @@
 // A rigid body has 17 values, one more than a float line holds. Its inverse
 // mass therefore lives beside the records, in a dense array of its own
 // (PackedView<PackedRigid<T>>::inv_mass), and the record holds the other 16:
-// one line per body in float, two in double, instead of two and three. The
-// number of lines per body is what this path costs: on this project's
-// machine (AMD EPYC Zen 4, 2 threads, 2M bodies, 4M random contacts) a
-// memory-only loop over one-line records with the dense inverse-mass array
-// ran at 85 M contacts/s, over two-line records at 62, over three-line
-// records at 31 (docs/collision-law.md, "The packed layout"). The dense
-// array is 4 or 8 bytes per body, so it stays in the caches far better than
-// the records it serves; the schedule reads it in one stream.
+// one line per body in float, two in double, instead of two and three, and
+// half (float) or two thirds (double) of the memory. The dense array is 4 or
+// 8 bytes per body: it stays in the caches far better than the records it
+// serves, and the schedule reads it in one stream. A solve reads it and
+// never writes it, so SoA input that the solver packs lends it its own
+// inv_mass array.
+//
+// What it bought, measured (AMD EPYC Zen 4, AVX-512, old and new library
+// alternated): in cache, rigid double 1.14x and rigid float 1.02x; at 4M
+// debris contacts on 2 threads, no change, because that path is bound by
+// the contacts' lines, read through ~24 dependency levels, not by the
+// records (the memory-only twin of the same accesses, bench/packed_twin.cpp,
+// runs at the kernel's speed; README, "Latest figures").
 //
 // The layout holds the same values as the SoA views, in the same units, and
 // converts to and from them exactly (a copy, no arithmetic): a caller may
