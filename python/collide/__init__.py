@@ -23,7 +23,17 @@ from __future__ import annotations
 import numpy as _np
 
 from . import _collide
-from ._collide import Bodies, Contacts, PackedBodies, Reference, Schedule, Solver, error_bound_eps
+from ._collide import (
+    Bodies,
+    Contacts,
+    PackedBodies,
+    Reference,
+    Schedule,
+    Solver,
+    accurate_error_ulps,
+    error_bound_eps,
+    error_target_eps,
+)
 
 __all__ = [
     "Bodies",
@@ -32,7 +42,9 @@ __all__ = [
     "Reference",
     "Schedule",
     "Solver",
+    "accurate_error_ulps",
     "error_bound_eps",
+    "error_target_eps",
     "from_physical",
     "generate",
     "impulse_error",
@@ -42,6 +54,7 @@ __all__ = [
     "read_scene",
     "reference_solve",
     "report",
+    "report_hard",
     "best_isa",
     "isa_supported",
     "simd_width",
@@ -152,6 +165,22 @@ def report(*, n=4_000_000, debris_n=None, threads=(1, 2), sample=100_000, runs=5
     columns). Takes minutes with the defaults; ``quick=True`` for a smoke run."""
     return _collide.report(n=n, debris_n=debris_n, threads=list(threads), sample=sample, runs=runs, seed=seed,
                            quick=quick)
+
+
+def report_hard(*, n=1000, runs=5):
+    """The hard section of ``collide report --hard`` as a list of dicts: every
+    scene of the hard catalogue (huge mass ratios, immovable bodies, needle
+    inertia, grazing contacts, tiny and huge scales, subnormals, chains of
+    shared bodies) in float and double, fast and accurate mode, SIMD at one
+    thread, with speed and error. ``n`` is the number of pairs of each pair
+    family (the shared scenes have fixed sizes); ``runs`` the least number of
+    timed runs. Keys: family, model, precision, mode ("fast" or "accurate"),
+    shared, n, acting, threads, isa, runs, seconds, collisions_per_second,
+    max_err_eps and p99_err_eps (the fast mode's unit, target
+    ``error_target_eps``), max_err_ulps (the accurate mode's unit, bound
+    ``accurate_error_ulps``; None where this build has no reference precise
+    enough to judge it) and judge (that reference's precision)."""
+    return _collide.report_hard(n=n, runs=runs)
 
 
 def isa_supported(isa):

@@ -14,6 +14,8 @@ AccuracyName = Literal["fast", "accurate"]
 
 __version__: str
 error_bound_eps: float
+error_target_eps: float
+accurate_error_ulps: float
 
 class Bodies:
     """N bodies over the caller's arrays (no copy): inv_mass (N,), inv_inertia,
@@ -199,6 +201,7 @@ def report(
     seed: int = 1,
     quick: bool = False,
 ) -> list[dict[str, Any]]: ...
+def report_hard(*, n: int = 1000, runs: int = 5) -> list[dict[str, Any]]: ...
 def isa_supported(isa: IsaName) -> bool: ...
 def best_isa() -> str: ...
 def simd_width(isa: IsaName = "auto", dtype: type[Float] | np.dtype[Any] = ...) -> int: ...

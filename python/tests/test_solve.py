@@ -183,3 +183,27 @@ def test_report_quick_rows():
     assert {r["scene"] for r in rows} == {"pairs", "debris"}
     with pytest.raises(ValueError, match="runs"):
         collide.report(n=10, runs=0)
+
+
+def test_report_hard_rows():
+    # The hard section from Python: every catalogue scene in both precisions
+    # and both modes, each fast row within the fast mode's target and each
+    # judged accurate row within its ulps (the C++ report test checks the
+    # same rows through the CLI).
+    rows = collide.report_hard(n=200, runs=1)
+    assert rows
+    assert {r["mode"] for r in rows} == {"fast", "accurate"}
+    assert {r["precision"] for r in rows} == {"float", "double"}
+    assert {"mass-ratio", "grazing"} <= {r["family"] for r in rows}
+    keys = {(r["family"], r["model"], r["precision"]) for r in rows}
+    assert len(rows) == 2 * len(keys)  # one fast and one accurate row per scene, model and precision
+    for r in rows:
+        assert r["collisions_per_second"] > 0 and r["runs"] >= 1 and 0 <= r["acting"] <= r["n"]
+        assert r["max_err_eps"] <= collide.error_target_eps, r
+        if r["mode"] == "accurate" and r["max_err_ulps"] is not None:
+            assert r["max_err_ulps"] <= collide.accurate_error_ulps, r
+    assert any(r["max_err_ulps"] is not None for r in rows if r["mode"] == "accurate")
+    with pytest.raises(ValueError, match="hard_n"):
+        collide.report_hard(n=0)
+    with pytest.raises(ValueError, match="runs"):
+        collide.report_hard(runs=0)

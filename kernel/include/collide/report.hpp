@@ -157,6 +157,11 @@ struct ReportOptions {
 /// Throws std::invalid_argument for options out of range.
 Report measure_report(const ReportOptions& options);
 
+/// Only the hard section (the rows `collide report --hard` adds), for
+/// callers that want it alone (the Python module's report_hard()). Reads
+/// hard_n and runs, checked as measure_report checks them.
+std::vector<HardRow> measure_hard_report(const ReportOptions& options);
+
 // ---------------------------------------------------------------------------
 // Output (report_output.cpp).
 // ---------------------------------------------------------------------------

@@ -573,6 +573,14 @@ class Runner {
 // The run.
 // ---------------------------------------------------------------------------
 
+std::vector<HardRow> measure_hard_report(const ReportOptions& options) {
+  if (options.runs < 1 || options.runs > 1000) throw std::invalid_argument("report: runs must be from 1 to 1000");
+  if (options.hard_n < 1 || options.hard_n > 0x7FFFFFFFULL) {
+    throw std::invalid_argument("report: hard_n must be from 1 to 2^31 - 1");
+  }
+  return measure_hard_rows(options, [](const std::string&) {});
+}
+
 Report measure_report(const ReportOptions& options) {
   // The same ranges as the usage of `collide report`: pairs use 2n body ids,
   // which are 32-bit.
