@@ -1092,6 +1092,18 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
 // The report.
 // ---------------------------------------------------------------------------
 
+/// f() (a report measurement) without the GIL; options out of range
+/// (std::invalid_argument) become ValueError.
+template <class F>
+auto measure_without_gil(F&& f) {
+  try {
+    py::gil_scoped_release release;
+    return f();
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+}
+
 py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::vector<int> threads, std::size_t sample,
                    int runs, std::uint64_t seed, bool quick) {
   ReportOptions o;
@@ -1102,13 +1114,7 @@ py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::vect
   o.runs = runs;
   o.seed = seed;
   o.quick = quick;
-  Report r;
-  try {
-    py::gil_scoped_release release;
-    r = measure_report(o);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
+  const Report r = measure_without_gil([&] { return measure_report(o); });
   py::list rows;
   for (const ReportRow& x : r.rows) {
     py::dict d;
@@ -1148,13 +1154,7 @@ py::list report_hard_py(std::size_t n, int runs) {
   o.hard = true;
   o.hard_n = n;
   o.runs = runs;
-  std::vector<HardRow> hard;
-  try {
-    py::gil_scoped_release release;
-    hard = measure_hard_report(o);
-  } catch (const std::invalid_argument& e) {
-    throw py::value_error(e.what());
-  }
+  const std::vector<HardRow> hard = measure_without_gil([&] { return measure_hard_report(o); });
   py::list rows;
   for (const HardRow& x : hard) {
     py::dict d;
