@@ -281,9 +281,9 @@ class Runner {
   }
 
   [[nodiscard]] std::size_t expected_rows() const {
-    const std::size_t kernel = std::size_t{2 /*precisions*/ * 3 /*models*/} * kernel_variants().size();
+    const std::size_t kernel = std::size_t{2} /*precisions*/ * 3 /*models*/ * kernel_variants().size();
     const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
-    std::size_t rows = std::size_t{2 /*scenes*/ * 2 /*friction*/} * (kernel + slow);
+    std::size_t rows = std::size_t{2} /*scenes*/ * 2 /*friction*/ * (kernel + slow);
     if (!bullet_version().empty()) ++rows;
     return rows;
   }
