@@ -29,7 +29,8 @@ bool same_record_bytes(const Record& x, const Record& y) {
   constexpr std::size_t values = std::is_same_v<Record, PackedRigid<T>>    ? 16
                                  : std::is_same_v<Record, PackedSphere<T>> ? 11
                                                                            : 4;
-  return std::memcmp(&x, &y, values * sizeof(T)) == 0;
+  // The bits, on purpose: -0, NaN payloads and subnormals must survive.
+  return std::memcmp(&x, &y, values * sizeof(T)) == 0;  // NOLINT(bugprone-suspicious-memory-comparison)
 }
 
 template <class T>

@@ -63,7 +63,7 @@ std::array<const T*, 17> body_arrays(const BodyView<const T>& v) {
 template <class T>
 bool same_bits(const T& x, const T& y) {
   static_assert(std::is_same_v<T, float> || std::is_same_v<T, double>, "bitwise comparison of padded types");
-  return std::memcmp(&x, &y, sizeof(T)) == 0;
+  return std::memcmp(&x, &y, sizeof(T)) == 0;  // NOLINT(bugprone-suspicious-memory-comparison): the bits, on purpose
 }
 
 /// Every field of every body identical bit for bit, except bodies for which
