@@ -133,7 +133,9 @@ COLLIDE_LANE_INLINE Vec3<V> narrow(const Vec3<W>& w) {
 }
 
 /// The rotation of q / |q|, as the law defines it: q is normalised here
-/// (s = 2 / |q|^2), where the fast mode trusts the stored q to be unit.
+/// (s = 2 / |q|^2), in the lanes' own precision in the fast mode and in the
+/// wider lanes in the accurate mode, from the q the caller stored (any q the
+/// input rules accept: |q|^2 a normal, finite number).
 template <class W>
 COLLIDE_LANE_INLINE Mat3<W> normalised_rotation(const QuatLanes<W>& q) {
   return rotation(q.w, q.x, q.y, q.z, W(2) / (((q.w * q.w + q.x * q.x) + q.y * q.y) + q.z * q.z));
@@ -353,7 +355,8 @@ COLLIDE_LANE_INLINE V compensated_normal_impulse(const V& vh, const V& vl, const
 }
 
 /// The normal impulse in the fast mode. The law normalises n; the stored n
-/// is unit only to a few eps, and the kernels take it as it is. The impulse
+/// is the caller's, unit only within the input tolerance (collide/rules.hpp),
+/// and the kernels take it as it is. The impulse
 /// P = jn n is then the law's when jn = -(1 + e) (u . n) / D with
 ///     D = |n|^2 (1/ma + 1/mb) + ka(n) + kb(n)   (= |n|^2 K(n / |n|)),
 /// since the lever terms ka, kb, computed from the stored n, already carry
@@ -460,7 +463,17 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
     const auto may_slide = approaching && (contact.mu > V(0));
     if (stdx::any_of(may_slide)) {
       const Vec3<V> u_after = relative_velocity(a, b, ra, rb);
-      const Vec3<V> ut = u_after - n * dot(u_after, n);
+      // The tangential part of u' about the law's unit normal n / |n|. The
+      // accurate mode's n is unit in its wider lanes; the fast mode's is the
+      // caller's, unit within the input tolerance, so its projection divides
+      // by |n|^2 (taking |n| = 1 would leave a normal component of
+      // (|n|^2 - 1) u'.n in ut, up to 2e-3 of it).
+      Vec3<V> ut;
+      if constexpr (std::is_same_v<Mode, FastMode>) {
+        ut = u_after - n * (dot(u_after, n) / dot(n, n));
+      } else {
+        ut = u_after - n * dot(u_after, n);
+      }
       const SlidingDirection<V> slide = sliding_direction(ut);
       // Slides when ut is nonzero and every component finite (scaled, they
       // are at most 2^40); a NaN or inf component never slides. |ut| itself
@@ -470,7 +483,11 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<
       const LeverArm<V> tarm_a = lever_arm(a, ra, t, contact.c);
       const LeverArm<V> tarm_b = lever_arm(b, rb, t, contact.c);
       const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
-      const V jt = select(sliding, lane_min(slide.speed / k_t, contact.mu * jn), V(0));
+      // The Coulomb cap is mu times the law's normal impulse, |P| = |jn n|:
+      // jn itself in the accurate mode (n unit), jn |n| in the fast mode.
+      V cap = contact.mu * jn;
+      if constexpr (std::is_same_v<Mode, FastMode>) cap = cap * lane_sqrt(dot(n, n));
+      const V jt = select(sliding, lane_min(slide.speed / k_t, cap), V(0));
       apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
       result.j = select(sliding, result.j - t * jt, result.j);
     }

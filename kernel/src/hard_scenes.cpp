@@ -581,6 +581,20 @@ std::vector<HardScene> hard_scene_catalogue() {
 }
 
 template <class T>
+SceneRecords<T> off_unit_directions(SceneRecords<T> records, std::uint64_t seed) {
+  SceneRng rng(seed);
+  for (ContactRecord<T>& c : records.contacts) {
+    const double scale = 1 + rng.uniform(-9e-4, 9e-4);
+    for (T& x : c.n) x = static_cast<T>(static_cast<double>(x) * scale);
+  }
+  for (BodyRecord<T>& b : records.bodies) {
+    const double scale = rng.log_uniform(0.5, 2.0);
+    for (T& x : b.q) x = static_cast<T>(static_cast<double>(x) * scale);
+  }
+  return records;
+}
+
+template <class T>
 Scene<T> build_hard_scene(const HardScene& scene, std::size_t count) {
   // The seeds of tests/hard/, so that the report shows the scenes the tests hold.
   const std::string& f = scene.family;
@@ -624,6 +638,7 @@ Scene<T> build_hard_scene(const HardScene& scene, std::size_t count) {
                                            std::uint64_t);                                              \
   template SceneRecords<T> star_scene<T>(std::size_t, bool, Model, std::uint64_t);                      \
   template SceneRecords<T> cluster_scene<T>(std::size_t, double, Model, std::uint64_t);                 \
+  template SceneRecords<T> off_unit_directions<T>(SceneRecords<T>, std::uint64_t);                      \
   template Scene<T> build_hard_scene<T>(const HardScene&, std::size_t);
 COLLIDE_FAMILIES(float)
 COLLIDE_FAMILIES(double)

@@ -64,8 +64,8 @@ COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyL
     f(view.q.x, a.q.x, b.q.x);
     f(view.q.y, a.q.y, b.q.y);
     f(view.q.z, a.q.z, b.q.z);
-    a.rotation = rotation(a.q.w, a.q.x, a.q.y, a.q.z);
-    b.rotation = rotation(b.q.w, b.q.x, b.q.y, b.q.z);
+    a.rotation = normalised_rotation(a.q);
+    b.rotation = normalised_rotation(b.q);
   } else if constexpr (std::is_same_v<M, SphereModel>) {
     f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
   }

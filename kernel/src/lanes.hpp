@@ -245,9 +245,8 @@ struct Mat3 {
 };
 
 /// The rotation of the quaternion (w, x, y, z) with s = 2 / |q|^2: s = 2
-/// (the default) trusts q to be unit, as the fast mode does with the stored
-/// q; the accurate mode and the rigid float kernel's lever arms pass
-/// 2 / |q|^2, which normalises q as the law says (contact_kernel.hpp).
+/// (the default) takes q to be unit; the kernels pass 2 / |q|^2, which
+/// normalises q as the law says (normalised_rotation, contact_kernel.hpp).
 template <class V>
 COLLIDE_LANE_INLINE Mat3<V> rotation(const V& w, const V& x, const V& y, const V& z, const V& s = V(2)) {
   const V one(1);

@@ -37,7 +37,7 @@ COLLIDE_LANE_INLINE void read_records(const PackedView<Record>& view, const Inde
     body.w = {x[3], x[4], x[5]};
     body.p = {x[6], x[7], x[8]};
     body.q = {x[9], x[10], x[11], x[12]};
-    body.rotation = rotation(x[9], x[10], x[11], x[12]);
+    body.rotation = normalised_rotation(body.q);
     body.inv_inertia = {x[13], x[14], x[15]};
     body.inv_mass = gather<V>(static_cast<const T*>(view.inv_mass), idx);
   } else if constexpr (std::is_same_v<Record, PackedSphere<T>>) {

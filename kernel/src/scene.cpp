@@ -1,8 +1,10 @@
 // scene.cpp - the owning SoA buffers of bodies.hpp and contacts.hpp.
 //
 // The only arithmetic here is the conversion from scene-file units to what the
-// kernel consumes: 1/m, 1/I (0 for inf), q / |q| and n / |n|. It is done once,
-// at the boundary, so that the kernels never divide by a mass.
+// kernel consumes: 1/m and 1/I (0 for inf). It is done once, at the boundary,
+// so that the kernels never divide by a mass. q and n are stored as given:
+// the law normalises them, and the kernels do so in the precision of the
+// accuracy mode, so the accurate mode starts from the caller's values.
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -18,19 +20,8 @@
 namespace collide {
 namespace {
 
-// sqrt, isinf and inf for every T a buffer holds (__float128 has no
-// std:: overloads, and numeric_limits knows it only in GNU mode).
-template <class T>
-T scene_sqrt(T x) {
-#if COLLIDE_HAS_FLOAT128
-  if constexpr (std::is_same_v<T, __float128>) {
-    return sqrtq(x);
-  } else
-#endif
-  {
-    return std::sqrt(x);
-  }
-}
+// isinf and inf for every T a buffer holds (__float128 has no std::
+// overloads, and numeric_limits knows it only in GNU mode).
 template <class T>
 bool is_infinite(T x) {
   return x == x && !(x - x == x - x);
@@ -93,12 +84,12 @@ void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
   ix_[i] = immovable ? T(0) : inverse_or_zero(body.I[0]);
   iy_[i] = immovable ? T(0) : inverse_or_zero(body.I[1]);
   iz_[i] = immovable ? T(0) : inverse_or_zero(body.I[2]);
-  const T qn =
-      scene_sqrt(body.q[0] * body.q[0] + body.q[1] * body.q[1] + body.q[2] * body.q[2] + body.q[3] * body.q[3]);
-  qw_[i] = body.q[0] / qn;
-  qx_[i] = body.q[1] / qn;
-  qy_[i] = body.q[2] / qn;
-  qz_[i] = body.q[3] / qn;
+  // q as given: the kernels normalise it, as the law says, in the precision
+  // of the accuracy mode (normalising here would round it for both).
+  qw_[i] = body.q[0];
+  qx_[i] = body.q[1];
+  qy_[i] = body.q[2];
+  qz_[i] = body.q[3];
   px_[i] = body.p[0];
   py_[i] = body.p[1];
   pz_[i] = body.p[2];
@@ -187,10 +178,10 @@ void ContactBuffer<T>::set(std::size_t i, const ContactRecord<T>& contact) {
   cx_[i] = contact.c[0];
   cy_[i] = contact.c[1];
   cz_[i] = contact.c[2];
-  const T nn = scene_sqrt(contact.n[0] * contact.n[0] + contact.n[1] * contact.n[1] + contact.n[2] * contact.n[2]);
-  nx_[i] = contact.n[0] / nn;
-  ny_[i] = contact.n[1] / nn;
-  nz_[i] = contact.n[2] / nn;
+  // n as given, like q above.
+  nx_[i] = contact.n[0];
+  ny_[i] = contact.n[1];
+  nz_[i] = contact.n[2];
   e_[i] = contact.e;
   mu_[i] = contact.mu;
 }

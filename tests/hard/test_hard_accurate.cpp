@@ -21,7 +21,13 @@
 //   identical bytes;
 // * the fast mode on the same scene is printed beside it, and for grazing
 //   contacts the fast mode really is far outside the target (so the family
-//   tests what it claims).
+//   tests what it claims);
+// * the same holds on the caller's own values: families whose normals are
+//   unit only within the input tolerance and whose quaternions are not unit
+//   at all (off_unit_directions), judged against the exact law on exactly
+//   those values, through the library and through `collide solve`; and a
+//   normal rounded to unit length in T before the law (what a reader that
+//   normalised on storing did) is far outside the target there.
 // The "[accurate]" lines are the figures of docs/collision-law.md.
 #include <cmath>
 #include <cstddef>
@@ -36,7 +42,14 @@
 #include <gtest/gtest.h>
 
 #include "collide/check.hpp"
+#include "collide/scene_io.hpp"
 #include "hard/hard_check.hpp"
+#if defined(COLLIDE_CLI_PATH)
+#include <charconv>
+#include <filesystem>
+
+#include "support/run_cli.hpp"
+#endif
 
 #if !COLLIDE_HAS_FLOAT128
 #error "test_hard_accurate judges double against the __float128 reference (GCC on x86-64)"
@@ -264,6 +277,153 @@ TEST(HardAccurate, SharedBodies) {
   run(float{});
   run(double{});
 }
+
+// ---------------------------------------------------------------------------
+// The caller's own values: n unit only within tolerance, q not unit.
+// ---------------------------------------------------------------------------
+
+/// The single-contact families of the target, as a caller might hand them
+/// over (off_unit_directions), for `fit`.
+template <class T>
+std::vector<std::pair<std::string, SceneRecords<T>>> off_unit_families(Model fit) {
+  std::vector<std::pair<std::string, SceneRecords<T>>> f;
+  f.emplace_back("grazing", off_unit_directions(grazing_family<T>(kCount, fit, 15), 41));
+  f.emplace_back("mass-ratio", off_unit_directions(mass_ratio_family<T>(kCount, fit, 11), 42));
+  f.emplace_back("unit-scales", off_unit_directions(unit_scale_family<T>(kCount, fit, 16), 43));
+  f.emplace_back("stick-slip", off_unit_directions(stick_slip_family<T>(kCount, fit, 20), 44));
+  if (fit != Model::particle) {
+    f.emplace_back("long-lever", off_unit_directions(long_lever_family<T>(kCount, fit, 14), 45));
+  }
+  if (fit == Model::rigid) f.emplace_back("needle", off_unit_directions(needle_family<T>(kCount, 13), 46));
+  return f;
+}
+
+/// Largest | |n| - 1 | and | |q| - 1 | of a scene, in long double.
+template <class T>
+std::pair<long double, long double> off_unit_extent(const SceneRecords<T>& r) {
+  long double n_off = 0, q_off = 0;
+  for (const ContactRecord<T>& c : r.contacts) {
+    const long double x = c.n[0], y = c.n[1], z = c.n[2];
+    n_off = std::max(n_off, std::fabs(std::sqrt(x * x + y * y + z * z) - 1));
+  }
+  for (const BodyRecord<T>& b : r.bodies) {
+    const long double w = b.q[0], x = b.q[1], y = b.q[2], z = b.q[3];
+    q_off = std::max(q_off, std::fabs(std::sqrt(w * w + x * x + y * y + z * z) - 1));
+  }
+  return {n_off, q_off};
+}
+
+/// The scene with every normal rounded to unit length in T before the law
+/// sees it: what the accurate mode got when the reader normalised n on
+/// storing it.
+template <class T>
+Scene<T> with_normals_rounded(const SceneRecords<T>& r) {
+  SceneRecords<T> rounded = r;
+  for (ContactRecord<T>& c : rounded.contacts) {
+    const T len = std::sqrt(c.n[0] * c.n[0] + c.n[1] * c.n[1] + c.n[2] * c.n[2]);
+    for (T& x : c.n) x /= len;
+  }
+  return rounded.scene();
+}
+
+TEST(HardAccurate, CallersValuesOffUnit) {
+  each(kAllFits, [](auto zero, Model fit) {
+    using T = decltype(zero);
+    for (const auto& [family, records] : off_unit_families<T>(fit)) {
+      const auto [n_off, q_off] = off_unit_extent(records);
+      // The scene is what it claims: normals off by up to the tolerance,
+      // quaternions far from unit.
+      EXPECT_GT(n_off, 5e-4L) << family;
+      EXPECT_LE(n_off, 1e-3L) << family;
+      EXPECT_GT(q_off, 0.4L) << family;
+      run_accurate<T>(family + "-off-unit", records.scene(), fit);
+      if (family == "grazing") {
+        // Rounding n to unit length in T first moves vn by |u| eps, orders
+        // of magnitude beyond the target on the flattest contacts.
+        const Scene<T> rounded = with_normals_rounded(records);
+        Scene<Judge<T>> exact = convert_scene<Judge<T>>(records.scene());
+        const ImpulseBuffer<Judge<T>> ref = test::reference(exact.bodies, exact.contacts.view());
+        const Outcome<T> off = kernel_result(rounded, rounded.bodies, fit, accurate_options<T>(Path::simd));
+        EXPECT_GT(ulp_errors(off.j, ref).max, 1000 * kAccurateUlps);
+      }
+    }
+  });
+}
+
+#if defined(COLLIDE_CLI_PATH)
+/// Reads an impulses file into T triples (the header checked).
+template <class T>
+std::vector<std::array<T, 3>> read_impulse_rows(const std::string& path) {
+  const std::string text = read_file(path);
+  std::vector<std::array<T, 3>> rows;
+  std::size_t pos = text.find('\n');
+  EXPECT_EQ(text.substr(0, pos + 1), impulses_header());
+  while (pos != std::string::npos && pos + 1 < text.size()) {
+    std::array<T, 3> row{};
+    const char* p = text.data() + pos + 1;
+    const char* end = text.data() + text.size();
+    for (int k = 0; k < 3; ++k) {
+      const auto [ptr, ec] = std::from_chars(p, end, row[k]);
+      EXPECT_EQ(ec, std::errc()) << "row " << rows.size();
+      p = ptr + 1;  // past ',' or '\n'
+    }
+    rows.push_back(row);
+    pos = static_cast<std::size_t>(p - text.data()) - 1;
+  }
+  return rows;
+}
+
+/// `collide solve --accuracy accurate` on the off-unit families written as
+/// scene files (shortest round-trip text, so the file holds exactly the
+/// records' values): J within the target of the exact law on those values.
+TEST(HardAccurate, CliOnCallersValuesOffUnit) {
+  namespace fs = std::filesystem;
+  each(kAllFits, [](auto zero, Model fit) {
+    using T = decltype(zero);
+    for (const auto& [family, records] : off_unit_families<T>(fit)) {
+      const std::string precision = test::type_name<T>();
+      SCOPED_TRACE(family + " " + precision + " " + to_string(fit));
+      const fs::path dir = fs::path(COLLIDE_TEST_TMP) / ("off-unit-" + family + "-" + precision + "-" + to_string(fit));
+      fs::create_directories(dir);
+      BodyTable<T> table;
+      for (const BodyRecord<T>& b : records.bodies) table.push_back(b);
+      {
+        OutputFile out((dir / "bodies.csv").string());
+        write_body_table(out, table);
+        out.commit();
+      }
+      std::string contacts(contacts_header());
+      for (const ContactRecord<T>& c : records.contacts) append_contact_row(contacts, c);
+      {
+        OutputFile out((dir / "contacts.csv").string());
+        out.write(contacts);
+        out.commit();
+      }
+      const test::RunResult r = test::run_program(
+          COLLIDE_CLI_PATH, dir,
+          {"solve", "--bodies", (dir / "bodies.csv").string(), "--contacts", (dir / "contacts.csv").string(),
+           "--out-bodies", (dir / "out-bodies.csv").string(), "--out-impulses", (dir / "out-impulses.csv").string(),
+           "--precision", precision, "--accuracy", "accurate"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const auto rows = read_impulse_rows<T>((dir / "out-impulses.csv").string());
+      ASSERT_EQ(rows.size(), records.contacts.size());
+      ImpulseBuffer<T> j(rows.size());
+      for (std::size_t k = 0; k < rows.size(); ++k) {
+        j.view().j.x[k] = rows[k][0];
+        j.view().j.y[k] = rows[k][1];
+        j.view().j.z[k] = rows[k][2];
+      }
+      Scene<Judge<T>> exact = convert_scene<Judge<T>>(records.scene());
+      const ImpulseBuffer<Judge<T>> ref = test::reference(exact.bodies, exact.contacts.view());
+      const UlpStats<T> st = ulp_errors(j, ref);
+      std::cout << "[accurate-cli] " << family << " " << precision << " " << to_string(fit) << " max " << st.max
+                << " ulps" << std::endl;
+      EXPECT_LE(st.max, kAccurateUlps) << "worst contact " << st.worst;
+      fs::remove_all(dir);
+    }
+  });
+}
+#endif
 
 }  // namespace
 }  // namespace collide::hard

@@ -343,5 +343,35 @@ TEST(HardPairs, SpinDominated) {
   each(kRotatingFits, run);
 }
 
+TEST(HardPairs, CallersValuesOffUnit) {
+  // The fast mode on the caller's values: normals unit only within the
+  // input tolerance and quaternions of any length (off_unit_directions).
+  // The law normalises both; the fast mode does so in T inside the kernel
+  // (q in the rotation, n through |n|^2 in the normal impulse and in the
+  // tangent's projection), within the same target as on unit inputs.
+  auto run = [](auto zero, Model fit) {
+    using T = decltype(zero);
+    run_scene<T>("grazing-off-unit", off_unit_directions(grazing_family<T>(kCount, fit, 15), 41).scene(), fit,
+                 kCount * 3 / 4, conserved<T>);
+    run_scene<T>("mass-ratio-off-unit", off_unit_directions(mass_ratio_family<T>(kCount, fit, 11), 42).scene(), fit,
+                 kCount * 9 / 10, conserved<T>);
+    run_scene<T>("unit-scales-off-unit", off_unit_directions(unit_scale_family<T>(kCount, fit, 16), 43).scene(), fit,
+                 kCount * 9 / 10, conserved<T>);
+    run_scene<T>("stick-slip-off-unit", off_unit_directions(stick_slip_family<T>(kCount, fit, 20), 44).scene(), fit,
+                 kCount * 9 / 10, conserved<T>);
+    if (fit != Model::particle) {
+      run_scene<T>("long-lever-off-unit", off_unit_directions(long_lever_family<T>(kCount, fit, 14), 45).scene(), fit,
+                   kCount * 9 / 10, conserved<T>);
+      run_scene<T>("spin-off-unit", off_unit_directions(spin_family<T>(kCount, fit, 21), 47).scene(), fit,
+                   kCount * 9 / 10, conserved<T>);
+    }
+    if (fit == Model::rigid) {
+      run_scene<T>("needle-off-unit", off_unit_directions(needle_family<T>(kCount, 13), 46).scene(), fit,
+                   kCount * 9 / 10, conserved<T>);
+    }
+  };
+  each(kAllFits, run);
+}
+
 }  // namespace
 }  // namespace collide::hard

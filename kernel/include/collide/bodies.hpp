@@ -51,7 +51,9 @@ struct BodyView {
   /// Inverse principal moments of inertia about the body's own axes
   /// [1/(kg m^2)]; 0 means no rotational response about that axis.
   Vec3Array<T> inv_inertia;
-  /// Orientation: unit quaternion rotating the body frame into the world frame.
+  /// Orientation: the quaternion q / |q| rotates the body frame into the
+  /// world frame. The kernels normalise q (|q|^2 must be a normal, finite
+  /// number in T), so the caller's q reaches the accurate mode as given.
   QuatArray<T> q;
   /// Centre of mass in the world frame [m].
   Vec3Array<T> p;
@@ -119,7 +121,8 @@ class BodyBuffer {
   [[nodiscard]] std::size_t size() const { return inv_mass_.size(); }
 
   /// Appends a body given in physical units: stores 1/m and 1/I (0 for inf),
-  /// zeroes the inverse moments of an immovable body and normalises q.
+  /// zeroes the inverse moments of an immovable body and keeps q as given
+  /// (the kernels normalise it, as the law says).
   void push_back(const BodyRecord<T>& body);
   /// Writes body i from physical units, as push_back does.
   void set(std::size_t i, const BodyRecord<T>& body);

@@ -1,7 +1,8 @@
 // collide/contacts.hpp - the contact data model and the impulse output.
 //
-// A contact joins body `a` and body `b` at world point `c` with unit normal
-// `n` pointing from b towards a (the impulse on a is along +n). Restitution
+// A contact joins body `a` and body `b` at world point `c` with normal `n`
+// pointing from b towards a (the impulse on a is along +n); the law takes
+// n / |n|, so n need be unit only within the input tolerance. Restitution
 // and friction are optional arrays so that a scene pays only for what it
 // models:
 //   * `e == nullptr`   - every contact uses `uniform_e`;
@@ -26,7 +27,7 @@ struct ContactView {
   const BodyIndex* a = nullptr;  ///< body receiving +J
   const BodyIndex* b = nullptr;  ///< body receiving -J
   Vec3Array<const T> c;          ///< contact point, world frame [m]
-  Vec3Array<const T> n;          ///< unit normal from b towards a
+  Vec3Array<const T> n;          ///< normal from b towards a, |n| = 1 within 1e-3 (the kernels normalise it)
   const T* e = nullptr;          ///< restitution in [0, 1]; nullptr = uniform_e
   T uniform_e = 1;               ///< restitution when `e` is nullptr
   const T* mu = nullptr;         ///< Coulomb friction >= 0; nullptr = frictionless
@@ -62,7 +63,7 @@ template <class T>
 struct ContactRecord {
   BodyIndex a = 0, b = 0;
   T c[3] = {0, 0, 0};
-  T n[3] = {0, 0, 1};  ///< normalised by push_back
+  T n[3] = {0, 0, 1};  ///< unit within 1e-3; stored as given (the kernels normalise it)
   T e = 1;
   T mu = 0;
 };

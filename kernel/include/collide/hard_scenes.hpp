@@ -186,6 +186,16 @@ SceneRecords<T> stick_slip_family(std::size_t count, Model fit, std::uint64_t se
 template <class T>
 SceneRecords<T> spin_family(std::size_t count, Model fit, std::uint64_t seed);
 
+/// The scene as a caller might hand it over, rather than as the builders
+/// above store it: every normal scaled by 1 + d, d uniform in
+/// [-9e-4, 9e-4] (inside the input tolerance of 1e-3, collide/rules.hpp),
+/// and every quaternion by a factor log-uniform in [1/2, 2], each value
+/// rounded once to T. The law normalises n and q, so the physics is the
+/// same; what changes is what the kernels read, and an evaluation that
+/// rounds n or q before the law does is off by the rounding.
+template <class T>
+SceneRecords<T> off_unit_directions(SceneRecords<T> records, std::uint64_t seed);
+
 /// Shared-body scenes.
 
 /// Newton's cradles of 2 .. `longest` solid spheres (I = 2/5 m R^2, no spin),
