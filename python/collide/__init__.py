@@ -147,8 +147,8 @@ def write_scene(bodies_csv, contacts_csv, bodies, contacts):
 def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
     """Bodies from physical units: mass m (N,) (inf = immovable), principal
     moments ``inertia`` (3, N) (inf = no rotation about that axis), any
-    non-zero quaternion q (4, N) (normalised), p, v, w (3, N); v and w default
-    to zero. Array-likes are converted to ``dtype``; the result owns new arrays."""
+    non-zero quaternion q (4, N) (stored as given; the law normalises it),
+    p, v, w (3, N); v and w default to zero. Array-likes are converted to ``dtype``; the result owns new arrays."""
     dt = _np.dtype(dtype)
 
     def arr(x, rows):

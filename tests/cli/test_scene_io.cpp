@@ -176,9 +176,13 @@ TEST(SceneIo, ContactChecks) {
   }
 }
 
-TEST(SceneIo, NormalIsNormalisedAfterTheCheck) {
+TEST(SceneIo, NormalWithinToleranceIsStoredAsRead) {
+  // The law normalises n inside the evaluation; the reader keeps the file's
+  // value so that the accurate mode starts from it.
   const auto c = collide::parse_contacts<double>(kContactHeader + "0,1,0,0,0,0,0,1.0005,0.5,0\n", "c", 2);
-  EXPECT_DOUBLE_EQ(c.view().n.z[0], 1.0);
+  EXPECT_EQ(c.view().n.z[0], 1.0005);
+  const auto f = collide::parse_contacts<float>(kContactHeader + "0,1,0,0,0,0,0,1.0005,0.5,0\n", "c", 2);
+  EXPECT_EQ(f.view().n.z[0], 1.0005f);
 }
 
 /// A large file: many chunks are parsed in parallel.

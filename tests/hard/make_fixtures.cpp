@@ -12,8 +12,8 @@
 // * The scenes are the hard-case families of collide/hard_scenes.hpp drawn in
 //   float and written exactly (shortest round trip of the float value, read
 //   back as double it is the same number), so the file means the same scene
-//   to a float and a double run; only the normalisation of q and n, done in
-//   the precision of the run, differs.
+//   to a float and a double run (q and n are stored as read; the law
+//   normalises them inside the evaluation).
 // * The expected outputs are reference_solve<long double> (the world-frame
 //   transcription of the law, in input order) on the scene exactly as
 //   `collide solve --precision double` reads it (read_bodies, to_body_buffer,

@@ -16,8 +16,7 @@
 //   (eps(T) * impulse_scale plus the underflow floor);
 // * agrees with the committed expected_impulses.csv within that same bound
 //   (the expected files are the double reading's reference; the fixtures'
-//   numbers are float values, so a float run reads the same scene up to the
-//   normalisation of q and n - the test measures that difference too);
+//   numbers are float values, so a float run reads the same scene);
 // * writes velocities within the bound the impulses imply (below).
 // In the double run it also checks that the committed expected files are
 // current: within an ulp of what the reference gives today.

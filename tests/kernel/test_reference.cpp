@@ -136,8 +136,10 @@ TYPED_TEST(ReferenceTyped, DiagnosticsObeyTheLaw) {
     EXPECT_LE(r.jt, c.mu[k] * r.jn * (1 + 4 * eps));
     sliding += r.jt > 0 && r.jt >= c.mu[k] * r.jn * (1 - 4 * eps);
     sticking += r.jt > 0 && r.jt < c.mu[k] * r.jn * (1 - 4 * eps);
-    // J = jn n - jt t, t unit and orthogonal to n.
-    const S n[3] = {c.n.x[k], c.n.y[k], c.n.z[k]};
+    // J = jn n - jt t, t unit and orthogonal to n, with n the law's unit
+    // normal (the stored one is unit only to the rounding of the scene).
+    const S len = std::sqrt(c.n.x[k] * c.n.x[k] + c.n.y[k] * c.n.y[k] + c.n.z[k] * c.n.z[k]);
+    const S n[3] = {c.n.x[k] / len, c.n.y[k] / len, c.n.z[k] / len};
     const S jv[3] = {j.view().j.x[k], j.view().j.y[k], j.view().j.z[k]};
     S t[3], tn = 0, tt = 0;
     for (int i = 0; i < 3; ++i) {
