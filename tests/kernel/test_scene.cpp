@@ -79,7 +79,7 @@ TYPED_TEST(SceneBuffers, BodyPushBackStoresInverses) {
   EXPECT_EQ(back.I[0], T(2));
   EXPECT_EQ(back.I[1], inf);
   EXPECT_EQ(back.I[2], T(0.5));
-  EXPECT_EQ(back.q[0], T(0.5));
+  EXPECT_EQ(back.q[0], T(1));  // q as given
   EXPECT_EQ(b.record(1).m, inf);
   EXPECT_EQ(b.record(1).I[1], inf);
 
