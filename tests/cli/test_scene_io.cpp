@@ -134,10 +134,13 @@ TEST(SceneIo, FloatRangeIsCheckedInFloat) {
   const SceneError m = expect_scene_error(
       [] { (void)collide::parse_bodies<float>(kHeader + "1e-45,1,1,1,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"); });
   EXPECT_EQ(m.column(), "m");
+  EXPECT_EQ(m.reason(), "mass 1e-45 is too small: its inverse overflows float");
   // A quaternion that cannot be normalised in float.
   const SceneError q = expect_scene_error(
       [] { (void)collide::parse_bodies<float>(kHeader + "2,1,1,1,1e-25,1e-25,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"); });
   EXPECT_EQ(q.column(), "qw");
+  EXPECT_EQ(q.reason(),
+            "quaternion cannot be normalised in float: it is too close to zero (qw, qx, qy, qz = 1e-25, 1e-25, 0, 0)");
   EXPECT_NO_THROW((void)collide::parse_bodies<double>(kHeader + "2,1,1,1,1e-25,1e-25,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"));
 }
 

@@ -10,10 +10,15 @@
 //   table and the solved velocities.
 // * Every bad input of the spec is a SceneError whose message names the file,
 //   the 1-based line, the 0-based data row (the body or contact id) and the
-//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got '-1'".
-//   The checks run on the parsed T values, so a value that is fine in double
-//   but unusable in float (1e39, a quaternion too small to normalise) is
-//   rejected with the precision named.
+//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got -1".
+//   What the text itself gets wrong (not a number, an empty field, a missing
+//   or extra column, a value out of the range of T) is the reader's to say;
+//   a row whose every field parses is then checked with the rules of
+//   collide/rules.hpp, on the parsed T values, and the reason is theirs, the
+//   same text the buffers and the Python constructors give for the same
+//   value. So a value that is fine in double but unusable in float (1e39, a
+//   mass of 1e-45, a quaternion too small to normalise) is rejected with the
+//   precision named. A row with both kinds of defect reports the text one.
 // * The parse-from-memory entry points (`parse_bodies`, `parse_contacts`)
 //   take the text and a file name for the messages, so fuzzers and tests can
 //   drive the parser without files.
@@ -40,20 +45,15 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/output_file.hpp"
+#include "collide/rules.hpp"
 
 namespace collide {
 
-/// Columns of bodies.csv, in file order.
-inline constexpr std::array<std::string_view, 17> kBodyColumns = {"m",  "Ix", "Iy", "Iz", "qw", "qx", "qy", "qz", "px",
-                                                                  "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz"};
-/// Columns of contacts.csv, in file order.
-inline constexpr std::array<std::string_view, 10> kContactColumns = {"a",  "b",  "cx", "cy", "cz",
-                                                                     "nx", "ny", "nz", "e",  "mu"};
+// kBodyColumns, kContactColumns (the columns of bodies.csv and contacts.csv)
+// and kNormalTolerance come from collide/rules.hpp.
+
 /// Columns of the impulses file.
 inline constexpr std::array<std::string_view, 3> kImpulseColumns = {"jx", "jy", "jz"};
-
-/// Allowed deviation of |n| from 1 before n is normalised.
-inline constexpr double kNormalTolerance = 1e-3;
 
 /// A scene file that cannot be read or written. For a bad value, line() is
 /// the 1-based line, row() the 0-based data row (body or contact id) and
