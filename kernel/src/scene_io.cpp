@@ -589,6 +589,29 @@ BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
 }
 
 template <class T>
+BodyTable<T> to_body_table(const BodyView<const T>& bodies) {
+  using Table = BodyTable<T>;
+  Table table;
+  table.resize(bodies.count);
+  // 1/x with 1/0 = inf, as BodyBuffer::record reads a body back.
+  auto physical = [](T x) { return x == T(0) ? std::numeric_limits<T>::infinity() : T(1) / x; };
+  const T* from[Table::kCount] = {
+      bodies.inv_mass, bodies.inv_inertia.x, bodies.inv_inertia.y, bodies.inv_inertia.z, bodies.q.w, bodies.q.x,
+      bodies.q.y,      bodies.q.z,           bodies.p.x,           bodies.p.y,           bodies.p.z, bodies.v.x,
+      bodies.v.y,      bodies.v.z,           bodies.w.x,           bodies.w.y,           bodies.w.z};
+  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies.count, 1 << 14),
+                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t k = 0; k < Table::kCount; ++k) {
+                                T* to = table.column[k].data();
+                                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                                  to[i] = k <= Table::Iz ? physical(from[k][i]) : from[k][i];
+                                }
+                              }
+                            });
+  return table;
+}
+
+template <class T>
 ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_name, std::size_t body_count) {
   const std::string file(file_name);
   const std::string_view data = check_header(text, file, kContactColumns);
@@ -654,6 +677,8 @@ namespace {
 
 /// Upper bound on the characters of one number (double: 24, float: 15).
 constexpr std::size_t kMaxNumberChars = 26;
+/// Upper bound on the characters of one body id (2^32 - 1: 10).
+constexpr std::size_t kMaxIdChars = 12;
 
 template <class T>
 inline char* put_number(char* p, T value) {
@@ -754,6 +779,35 @@ auto impulse_row(const ImpulseView<const T>& impulses) {
   };
 }
 
+/// One contacts.csv row from its ids and its eight values (cx .. mu).
+template <class T>
+char* put_contact(char* p, BodyIndex a, BodyIndex b, const T* v) {
+  p = std::to_chars(p, p + kMaxIdChars, a).ptr;
+  *p++ = ',';
+  p = std::to_chars(p, p + kMaxIdChars, b).ptr;
+  for (int k = 0; k < 8; ++k) {
+    *p++ = ',';
+    p = put_number(p, v[k]);
+  }
+  *p++ = '\n';
+  return p;
+}
+
+template <class T>
+auto contact_row(const ContactView<T>& contacts) {
+  return [contacts](char* p, std::size_t k) {
+    const T v[8] = {contacts.c.x[k],
+                    contacts.c.y[k],
+                    contacts.c.z[k],
+                    contacts.n.x[k],
+                    contacts.n.y[k],
+                    contacts.n.z[k],
+                    contacts.e ? contacts.e[k] : contacts.uniform_e,
+                    contacts.mu ? contacts.mu[k] : T(0)};
+    return put_contact(p, contacts.a[k], contacts.b[k], v);
+  };
+}
+
 template <class T>
 void check_same_count(const BodyTable<T>& inputs, const BodyView<const T>& solved, const std::string& file) {
   if (inputs.size() != solved.count) {
@@ -764,6 +818,7 @@ void check_same_count(const BodyTable<T>& inputs, const BodyView<const T>& solve
 
 constexpr std::size_t kBodyRowChars = 17 * (kMaxNumberChars + 1);
 constexpr std::size_t kImpulseRowChars = 3 * (kMaxNumberChars + 1);
+constexpr std::size_t kContactRowChars = 2 * (kMaxIdChars + 1) + 8 * (kMaxNumberChars + 1);
 
 }  // namespace
 
@@ -788,6 +843,28 @@ template <class T>
 void write_body_table(OutputFile& out, const BodyTable<T>& table) {
   emit_rows([&](std::string_view s) { out.write(s); }, bodies_header(), table.size(), kBodyRowChars,
             body_table_row(table));
+}
+
+template <class T>
+void write_contacts(OutputFile& out, const ContactView<T>& contacts) {
+  emit_rows([&](std::string_view s) { out.write(s); }, contacts_header(), contacts.count, kContactRowChars,
+            contact_row(contacts));
+}
+
+template <class T>
+std::string format_body_table(const BodyTable<T>& table) {
+  std::string text;
+  emit_rows([&](std::string_view s) { text.append(s); }, bodies_header(), table.size(), kBodyRowChars,
+            body_table_row(table));
+  return text;
+}
+
+template <class T>
+std::string format_contacts(const ContactView<T>& contacts) {
+  std::string text;
+  emit_rows([&](std::string_view s) { text.append(s); }, contacts_header(), contacts.count, kContactRowChars,
+            contact_row(contacts));
+  return text;
 }
 
 template <class T>
@@ -825,17 +902,10 @@ void append_body_row(std::string& out, const BodyRecord<T>& body) {
 
 template <class T>
 void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
-  char buf[24];
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, contact.a).ptr);
-  out += ',';
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, contact.b).ptr);
+  char buf[kContactRowChars];
   const T v[8] = {contact.c[0], contact.c[1], contact.c[2], contact.n[0],
                   contact.n[1], contact.n[2], contact.e,    contact.mu};
-  for (const T x : v) {
-    out += ',';
-    append_number(out, x);
-  }
-  out += '\n';
+  out.append(buf, put_contact(buf, contact.a, contact.b, v));
 }
 
 // ---------------------------------------------------------------------------
@@ -851,6 +921,10 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template void write_bodies<T>(OutputFile&, const BodyTable<T>&, const BodyView<const T>&);    \
   template void write_impulses<T>(OutputFile&, const ImpulseView<const T>&);                    \
   template void write_body_table<T>(OutputFile&, const BodyTable<T>&);                          \
+  template void write_contacts<T>(OutputFile&, const ContactView<T>&);                          \
+  template std::string format_body_table<T>(const BodyTable<T>&);                               \
+  template std::string format_contacts<T>(const ContactView<T>&);                               \
+  template BodyTable<T> to_body_table<T>(const BodyView<const T>&);                             \
   template std::string format_bodies<T>(const BodyTable<T>&, const BodyView<const T>&);         \
   template std::string format_impulses<T>(const ImpulseView<const T>&);                         \
   template void append_number<T>(std::string&, T);                                              \

@@ -117,9 +117,15 @@ BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name);
 template <class T>
 BodyTable<T> read_bodies(const std::string& path);
 
-/// Converts a table into what the kernels consume (1/m, 1/I, unit q).
+/// Converts a table into what the kernels consume (1/m, 1/I, unit q),
+/// through BodyBuffer::set (std::invalid_argument for a body that breaks a
+/// rule; a table from parse_bodies has none).
 template <class T>
 BodyBuffer<T> to_body_buffer(const BodyTable<T>& table);
+/// The other way: a kernel view in physical units (1/x, inf for 0), what
+/// write_body_table writes as a scene file.
+template <class T>
+BodyTable<T> to_body_table(const BodyView<const T>& bodies);
 
 /// Parses the text of a contacts file whose ids refer to `body_count` bodies.
 /// |n| is checked against 1 within kNormalTolerance before n is normalised.
@@ -146,12 +152,20 @@ void write_impulses(OutputFile& out, const ImpulseView<const T>& impulses);
 /// Writes a body table as it is (a scene input file).
 template <class T>
 void write_body_table(OutputFile& out, const BodyTable<T>& table);
+/// Writes contacts as a contacts file (a scene input file), values as given;
+/// a view without e gets uniform_e in every row, one without mu gets 0.
+template <class T>
+void write_contacts(OutputFile& out, const ContactView<T>& contacts);
 
 /// In-memory forms of the writers above: the complete file text.
 template <class T>
 std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved);
 template <class T>
 std::string format_impulses(const ImpulseView<const T>& impulses);
+template <class T>
+std::string format_body_table(const BodyTable<T>& table);
+template <class T>
+std::string format_contacts(const ContactView<T>& contacts);
 
 /// Header lines, newline included.
 std::string_view bodies_header();
