@@ -5,13 +5,22 @@
 // so that the kernels never divide by a mass. q and n are stored as given:
 // the law normalises them, and the kernels do so in the precision of the
 // accuracy mode, so the accurate mode starts from the caller's values.
+//
+// set() and push_back() first check the record with the rules of
+// collide/rules.hpp (std::invalid_argument naming the element and the
+// column). The __float128 buffers of the reference have no rules of their
+// own: they are filled by exact conversion (convert_bodies, assign_exact)
+// from buffers that were checked in their own precision.
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/reference.hpp"  // COLLIDE_HAS_FLOAT128
+#include "collide/rules.hpp"
 
 #if COLLIDE_HAS_FLOAT128
 #include <quadmath.h>
@@ -50,6 +59,34 @@ T inverse_or_inf(T x) {
   return x == T(0) ? infinity<T>() : T(1) / x;
 }
 
+// The precisions rules.hpp states its rules for.
+template <class T>
+constexpr bool kHasRules = std::is_same_v<T, float> || std::is_same_v<T, double> || std::is_same_v<T, long double>;
+
+[[noreturn]] void throw_defect(const char* where, const char* element, std::size_t i, const Defect& defect) {
+  throw std::invalid_argument(std::string(where) + ": " + element + " " + std::to_string(i) + ", column '" +
+                              std::string(defect.column) + "': " + defect.reason);
+}
+
+// Throws std::invalid_argument("<where>: body <i>, column 'm': <reason>")
+// for a body that breaks a rule of rules.hpp.
+template <class T>
+void check_body(const char* where, std::size_t i, const BodyRecord<T>& body) {
+  if constexpr (kHasRules<T>) {
+    if (body_ok(body)) return;
+    if (const std::optional<Defect> d = body_defect(body)) throw_defect(where, "body", i, *d);
+  }
+}
+
+// The same for a contact (no body count: ids are not range-checked).
+template <class T>
+void check_contact(const char* where, std::size_t i, const ContactRecord<T>& contact) {
+  if constexpr (kHasRules<T>) {
+    if (contact_ok(contact)) return;
+    if (const std::optional<Defect> d = contact_defect(contact)) throw_defect(where, "contact", i, *d);
+  }
+}
+
 }  // namespace
 
 template <class T>
@@ -71,12 +108,14 @@ void BodyBuffer<T>::reserve(std::size_t n) {
 
 template <class T>
 void BodyBuffer<T>::push_back(const BodyRecord<T>& body) {
+  check_body("collide::BodyBuffer::push_back", size(), body);
   resize(size() + 1);
   set(size() - 1, body);
 }
 
 template <class T>
 void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
+  check_body("collide::BodyBuffer::set", i, body);
   const T inv_m = inverse_or_zero(body.m);
   const bool immovable = inv_m == T(0);
   inv_mass_[i] = inv_m;
@@ -167,12 +206,14 @@ void ContactBuffer<T>::reserve(std::size_t n) {
 
 template <class T>
 void ContactBuffer<T>::push_back(const ContactRecord<T>& contact) {
+  check_contact("collide::ContactBuffer::push_back", size(), contact);
   resize(size() + 1);
   set(size() - 1, contact);
 }
 
 template <class T>
 void ContactBuffer<T>::set(std::size_t i, const ContactRecord<T>& contact) {
+  check_contact("collide::ContactBuffer::set", i, contact);
   a_[i] = contact.a;
   b_[i] = contact.b;
   cx_[i] = contact.c[0];

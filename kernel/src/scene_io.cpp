@@ -20,9 +20,10 @@
 //   infinity and nan case-insensitively). A leading '+' is allowed. A value
 //   out of the range of T is an error if it overflows and rounds to a
 //   subnormal or zero if it underflows (strtof/strtod semantics).
-// * Every check of the spec runs on the value in T, the precision the kernel
-//   will see, plus what makes the kernel's own conversion safe: 1/m and 1/I
-//   finite, |q|^2 a normal finite number in T.
+// * The reader checks the text (numbers, columns, the range of T); the value
+//   rules of the spec are rules.hpp's (body_ok / contact_ok on the fast path,
+//   body_defect / contact_defect for the message), on the values in T, the
+//   precision the kernel will see.
 // * Writing: blocks of rows are formatted in parallel with std::to_chars
 //   (shortest text that reads back to the same T) and written in order
 //   through a tbb pipeline, so memory stays bounded and output is identical
@@ -43,6 +44,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <system_error>
 #include <type_traits>
 #include <utility>
@@ -302,13 +304,13 @@ NumberStatus parse_real(std::string_view field, T& value) {
   return NumberStatus::ok;
 }
 
-/// Parses a real and applies the checks every column shares: it parses,
-/// it is not NaN, and it is finite unless `inf_allowed`.
+/// Parses a real: the reader's own, text-level checks (the field is a
+/// number, and within the range of T). The value rules are rules.hpp's.
 template <class T>
-bool parse_value(std::string_view field, bool inf_allowed, T& value, std::string& reason) {
+bool parse_value(std::string_view field, T& value, std::string& reason) {
   switch (parse_real(field, value)) {
     case NumberStatus::ok:
-      break;
+      return true;
     case NumberStatus::empty:
       reason = "empty value";
       return false;
@@ -319,32 +321,12 @@ bool parse_value(std::string_view field, bool inf_allowed, T& value, std::string
       reason = quoted(field) + " is out of the range of " + precision_name<T>();
       return false;
   }
-  if (std::isnan(value)) {
-    reason = "NaN is not allowed";
-    return false;
-  }
-  if (std::isinf(value) && !inf_allowed) {
-    reason = "inf is not allowed here (only m, Ix, Iy and Iz may be inf): " + quoted(field);
-    return false;
-  }
-  return true;
+  return false;
 }
 
-/// Checks a mass or a moment: > 0, and its inverse finite in T.
-template <class T>
-bool check_positive(std::string_view field, T value, const char* what, std::string& reason) {
-  if (!(value > T(0))) {
-    reason = std::string(what) + " must be > 0, got " + quoted(field);
-    return false;
-  }
-  if (!std::isfinite(T(1) / value)) {
-    reason = std::string(what) + " " + quoted(field) + " is too small: its inverse overflows " + precision_name<T>();
-    return false;
-  }
-  return true;
-}
-
-/// Checks a body id: a non-negative integer below body_count.
+/// Parses a body id: a non-negative integer that fits BodyIndex. Whether it
+/// is below the body count is a rule (rules.hpp), checked with the row; an
+/// id too large for BodyIndex gets that rule's message here.
 bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id, std::string& reason) {
   field = trim(field);
   if (field.empty()) {
@@ -356,14 +338,12 @@ bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id
   if (*first == '+' && last - first > 1) ++first;
   std::uint64_t v = 0;
   const auto [ptr, ec] = std::from_chars(first, last, v);
-  const std::size_t limit = std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max());
   if (ptr != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
     reason = "body id must be a non-negative integer, got " + quoted(field);
     return false;
   }
-  if (ec == std::errc::result_out_of_range || v >= limit) {
-    reason = "body id " + std::string(field) + " is out of range: the scene has " + std::to_string(body_count) +
-             " bodies" + (body_count > 0 ? " (ids 0 to " + std::to_string(body_count - 1) + ")" : std::string());
+  if (ec == std::errc::result_out_of_range || v > std::numeric_limits<BodyIndex>::max()) {
+    reason = body_id_out_of_range(ec == std::errc() ? std::to_string(v) : std::string(first, last), body_count);
     return false;
   }
   id = static_cast<BodyIndex>(v);
@@ -388,41 +368,36 @@ bool fast_numbers(const char* p, const char* e, T* out) {
   return true;
 }
 
-/// The value checks of bodies.csv column k, without messages (the fast path).
+/// A body row's seventeen values (file order) as a record.
 template <class T>
-bool body_value_ok(std::size_t k, T v) {
-  if (std::isnan(v)) return false;
-  if (k <= 3) return v > T(0) && std::isfinite(T(1) / v);  // m, Ix, Iy, Iz
-  return std::isfinite(v);
+BodyRecord<T> body_record(const T* v) {
+  BodyRecord<T> r;
+  r.m = v[0];
+  for (int k = 0; k < 3; ++k) r.I[k] = v[1 + k];
+  for (int k = 0; k < 4; ++k) r.q[k] = v[4 + k];
+  for (int k = 0; k < 3; ++k) {
+    r.p[k] = v[8 + k];
+    r.v[k] = v[11 + k];
+    r.w[k] = v[14 + k];
+  }
+  return r;
 }
 
-/// Whether q/|q| can be computed in T as the kernel's conversion does:
-/// |q|^2 must be a normal, finite number. Reason in `reason` if not.
+/// A contact row's values after the ids (cx .. mu) into a record.
 template <class T>
-bool quaternion_ok(T qw, T qx, T qy, T qz, std::string* reason) {
-  if (qw == T(0) && qx == T(0) && qy == T(0) && qz == T(0)) {
-    if (reason) *reason = "zero quaternion (qw, qx, qy, qz are all 0)";
-    return false;
+void contact_values(const T* v, ContactRecord<T>& rec) {
+  for (int k = 0; k < 3; ++k) {
+    rec.c[k] = v[k];
+    rec.n[k] = v[3 + k];
   }
-  const T q2 = qw * qw + qx * qx + qy * qy + qz * qz;
-  if (!(q2 >= std::numeric_limits<T>::min()) || !std::isfinite(q2)) {
-    if (reason) {
-      *reason = std::string("quaternion cannot be normalised in ") + precision_name<T>() +
-                (std::isfinite(q2) ? ": it is too close to zero" : ": it is too large");
-    }
-    return false;
-  }
-  return true;
+  rec.e = v[6];
+  rec.mu = v[7];
 }
 
-/// |n| within kNormalTolerance of 1, judged in double from the T values:
-/// the tolerance is far above either rounding, and double cannot overflow.
-template <class T>
-bool normal_ok(const T* n, double* length) {
-  const double nx = n[0], ny = n[1], nz = n[2];
-  const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-  if (length) *length = len;
-  return std::fabs(len - 1.0) <= kNormalTolerance;
+/// The index of a rule's column among `names`.
+template <std::size_t N>
+std::size_t column_index(const std::array<std::string_view, N>& names, std::string_view column) {
+  return static_cast<std::size_t>(std::find(names.begin(), names.end(), column) - names.begin());
 }
 
 /// Splits the text into its header line and its data rows (trailing blank
@@ -569,28 +544,18 @@ BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name) {
   const std::string file(file_name);
   const std::string_view data = check_header(text, file, kBodyColumns);
   BodyTable<T> table;
-  using Table = BodyTable<T>;
   auto prepare = [&](std::size_t rows) { table.resize(rows); };
   auto parse_row = [&](const std::array<std::string_view, 17>& f, std::size_t row, Failure& failure) {
     T v[17];
     for (std::size_t k = 0; k < 17; ++k) {
-      const bool is_mass_or_moment = k <= Table::Iz;
-      if (!parse_value(f[k], is_mass_or_moment, v[k], failure.reason)) {
-        failure.column = k;
-        return false;
-      }
-      if (k == Table::m && !check_positive(f[k], v[k], "mass", failure.reason)) {
-        failure.column = k;
-        return false;
-      }
-      if (k >= Table::Ix && k <= Table::Iz && !check_positive(f[k], v[k], "moment of inertia", failure.reason)) {
+      if (!parse_value(f[k], v[k], failure.reason)) {
         failure.column = k;
         return false;
       }
     }
-    // The kernel's conversion divides q by sqrt(|q|^2) in T.
-    if (!quaternion_ok(v[Table::qw], v[Table::qx], v[Table::qy], v[Table::qz], &failure.reason)) {
-      failure.column = Table::qw;
+    if (std::optional<Defect> defect = body_defect(body_record(v))) {
+      failure.column = column_index(kBodyColumns, defect->column);
+      failure.reason = std::move(defect->reason);
       return false;
     }
     for (std::size_t k = 0; k < 17; ++k) table.column[k][row] = v[k];
@@ -598,11 +563,7 @@ BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name) {
   };
   auto fast_row = [&](const char* b, const char* e, std::size_t row) {
     T v[17];
-    if (!fast_numbers<17>(b, e, v)) return false;
-    for (std::size_t k = 0; k < 17; ++k) {
-      if (!body_value_ok(k, v[k])) return false;
-    }
-    if (!quaternion_ok<T>(v[Table::qw], v[Table::qx], v[Table::qy], v[Table::qz], nullptr)) return false;
+    if (!fast_numbers<17>(b, e, v) || !body_ok(body_record(v))) return false;
     for (std::size_t k = 0; k < 17; ++k) table.column[k][row] = v[k];
     return true;
   };
@@ -628,6 +589,29 @@ BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
 }
 
 template <class T>
+BodyTable<T> to_body_table(const BodyView<const T>& bodies) {
+  using Table = BodyTable<T>;
+  Table table;
+  table.resize(bodies.count);
+  // 1/x with 1/0 = inf, as BodyBuffer::record reads a body back.
+  auto physical = [](T x) { return x == T(0) ? std::numeric_limits<T>::infinity() : T(1) / x; };
+  const T* from[Table::kCount] = {
+      bodies.inv_mass, bodies.inv_inertia.x, bodies.inv_inertia.y, bodies.inv_inertia.z, bodies.q.w, bodies.q.x,
+      bodies.q.y,      bodies.q.z,           bodies.p.x,           bodies.p.y,           bodies.p.z, bodies.v.x,
+      bodies.v.y,      bodies.v.z,           bodies.w.x,           bodies.w.y,           bodies.w.z};
+  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies.count, 1 << 14),
+                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t k = 0; k < Table::kCount; ++k) {
+                                T* to = table.column[k].data();
+                                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                                  to[i] = k <= Table::Iz ? physical(from[k][i]) : from[k][i];
+                                }
+                              }
+                            });
+  return table;
+}
+
+template <class T>
 ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_name, std::size_t body_count) {
   const std::string file(file_name);
   const std::string_view data = check_header(text, file, kContactColumns);
@@ -643,65 +627,36 @@ ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_nam
       failure.column = 1;
       return false;
     }
-    if (rec.a == rec.b) {
-      failure.column = 1;
-      failure.reason = "contact of body " + std::to_string(rec.a) + " with itself (a == b)";
-      return false;
-    }
-    T* dst[8] = {&rec.c[0], &rec.c[1], &rec.c[2], &rec.n[0], &rec.n[1], &rec.n[2], &rec.e, &rec.mu};
+    T v[8];
     for (std::size_t k = 2; k < 10; ++k) {
-      if (!parse_value(f[k], false, *dst[k - 2], failure.reason)) {
+      if (!parse_value(f[k], v[k - 2], failure.reason)) {
         failure.column = k;
         return false;
       }
     }
-    if (!(rec.e >= T(0) && rec.e <= T(1))) {
-      failure.column = 8;
-      failure.reason = "e must be in [0, 1], got " + quoted(f[8]);
-      return false;
-    }
-    if (!(rec.mu >= T(0))) {
-      failure.column = 9;
-      failure.reason = "mu must be >= 0, got " + quoted(f[9]);
-      return false;
-    }
-    double len = 0;
-    if (!normal_ok(rec.n, &len)) {
-      failure.column = 5;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%.9g", len);
-      failure.reason = std::string("normal length ") + buf +
-                       " is not 1 within 1e-3 (nx, ny, nz = " + std::string(trim(f[5])) + ", " +
-                       std::string(trim(f[6])) + ", " + std::string(trim(f[7])) + ")";
+    contact_values(v, rec);
+    if (std::optional<Defect> defect = contact_defect(rec, body_count)) {
+      failure.column = column_index(kContactColumns, defect->column);
+      failure.reason = std::move(defect->reason);
       return false;
     }
     contacts.set(row, rec);  // normalises n; writes element `row` only
     return true;
   };
-  const std::size_t id_limit = std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max());
   auto fast_row = [&](const char* b, const char* e, std::size_t row) {
     std::uint64_t ids[2];
     for (std::uint64_t& id : ids) {
       const auto [ptr, ec] = std::from_chars(b, e, id);
-      if (ec != std::errc() || ptr == e || *ptr != ',' || id >= id_limit) return false;
+      if (ec != std::errc() || ptr == e || *ptr != ',' || id > std::numeric_limits<BodyIndex>::max()) return false;
       b = ptr + 1;
     }
-    if (ids[0] == ids[1]) return false;
     ContactRecord<T> rec;
-    T v[8];
-    if (!fast_numbers<8>(b, e, v)) return false;
-    for (const T x : v) {
-      if (!std::isfinite(x)) return false;
-    }
     rec.a = static_cast<BodyIndex>(ids[0]);
     rec.b = static_cast<BodyIndex>(ids[1]);
-    for (int k = 0; k < 3; ++k) {
-      rec.c[k] = v[k];
-      rec.n[k] = v[3 + k];
-    }
-    rec.e = v[6];
-    rec.mu = v[7];
-    if (!(rec.e >= T(0) && rec.e <= T(1)) || !(rec.mu >= T(0)) || !normal_ok(rec.n, nullptr)) return false;
+    T v[8];
+    if (!fast_numbers<8>(b, e, v)) return false;
+    contact_values(v, rec);
+    if (!contact_ok(rec, body_count)) return false;
     contacts.set(row, rec);
     return true;
   };
@@ -722,6 +677,8 @@ namespace {
 
 /// Upper bound on the characters of one number (double: 24, float: 15).
 constexpr std::size_t kMaxNumberChars = 26;
+/// Upper bound on the characters of one body id (2^32 - 1: 10).
+constexpr std::size_t kMaxIdChars = 12;
 
 template <class T>
 inline char* put_number(char* p, T value) {
@@ -822,6 +779,35 @@ auto impulse_row(const ImpulseView<const T>& impulses) {
   };
 }
 
+/// One contacts.csv row from its ids and its eight values (cx .. mu).
+template <class T>
+char* put_contact(char* p, BodyIndex a, BodyIndex b, const T* v) {
+  p = std::to_chars(p, p + kMaxIdChars, a).ptr;
+  *p++ = ',';
+  p = std::to_chars(p, p + kMaxIdChars, b).ptr;
+  for (int k = 0; k < 8; ++k) {
+    *p++ = ',';
+    p = put_number(p, v[k]);
+  }
+  *p++ = '\n';
+  return p;
+}
+
+template <class T>
+auto contact_row(const ContactView<T>& contacts) {
+  return [contacts](char* p, std::size_t k) {
+    const T v[8] = {contacts.c.x[k],
+                    contacts.c.y[k],
+                    contacts.c.z[k],
+                    contacts.n.x[k],
+                    contacts.n.y[k],
+                    contacts.n.z[k],
+                    contacts.e ? contacts.e[k] : contacts.uniform_e,
+                    contacts.mu ? contacts.mu[k] : T(0)};
+    return put_contact(p, contacts.a[k], contacts.b[k], v);
+  };
+}
+
 template <class T>
 void check_same_count(const BodyTable<T>& inputs, const BodyView<const T>& solved, const std::string& file) {
   if (inputs.size() != solved.count) {
@@ -832,6 +818,7 @@ void check_same_count(const BodyTable<T>& inputs, const BodyView<const T>& solve
 
 constexpr std::size_t kBodyRowChars = 17 * (kMaxNumberChars + 1);
 constexpr std::size_t kImpulseRowChars = 3 * (kMaxNumberChars + 1);
+constexpr std::size_t kContactRowChars = 2 * (kMaxIdChars + 1) + 8 * (kMaxNumberChars + 1);
 
 }  // namespace
 
@@ -856,6 +843,28 @@ template <class T>
 void write_body_table(OutputFile& out, const BodyTable<T>& table) {
   emit_rows([&](std::string_view s) { out.write(s); }, bodies_header(), table.size(), kBodyRowChars,
             body_table_row(table));
+}
+
+template <class T>
+void write_contacts(OutputFile& out, const ContactView<T>& contacts) {
+  emit_rows([&](std::string_view s) { out.write(s); }, contacts_header(), contacts.count, kContactRowChars,
+            contact_row(contacts));
+}
+
+template <class T>
+std::string format_body_table(const BodyTable<T>& table) {
+  std::string text;
+  emit_rows([&](std::string_view s) { text.append(s); }, bodies_header(), table.size(), kBodyRowChars,
+            body_table_row(table));
+  return text;
+}
+
+template <class T>
+std::string format_contacts(const ContactView<T>& contacts) {
+  std::string text;
+  emit_rows([&](std::string_view s) { text.append(s); }, contacts_header(), contacts.count, kContactRowChars,
+            contact_row(contacts));
+  return text;
 }
 
 template <class T>
@@ -893,17 +902,10 @@ void append_body_row(std::string& out, const BodyRecord<T>& body) {
 
 template <class T>
 void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
-  char buf[24];
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, contact.a).ptr);
-  out += ',';
-  out.append(buf, std::to_chars(buf, buf + sizeof buf, contact.b).ptr);
+  char buf[kContactRowChars];
   const T v[8] = {contact.c[0], contact.c[1], contact.c[2], contact.n[0],
                   contact.n[1], contact.n[2], contact.e,    contact.mu};
-  for (const T x : v) {
-    out += ',';
-    append_number(out, x);
-  }
-  out += '\n';
+  out.append(buf, put_contact(buf, contact.a, contact.b, v));
 }
 
 // ---------------------------------------------------------------------------
@@ -919,6 +921,10 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template void write_bodies<T>(OutputFile&, const BodyTable<T>&, const BodyView<const T>&);    \
   template void write_impulses<T>(OutputFile&, const ImpulseView<const T>&);                    \
   template void write_body_table<T>(OutputFile&, const BodyTable<T>&);                          \
+  template void write_contacts<T>(OutputFile&, const ContactView<T>&);                          \
+  template std::string format_body_table<T>(const BodyTable<T>&);                               \
+  template std::string format_contacts<T>(const ContactView<T>&);                               \
+  template BodyTable<T> to_body_table<T>(const BodyView<const T>&);                             \
   template std::string format_bodies<T>(const BodyTable<T>&, const BodyView<const T>&);         \
   template std::string format_impulses<T>(const ImpulseView<const T>&);                         \
   template void append_number<T>(std::string&, T);                                              \

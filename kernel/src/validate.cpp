@@ -28,10 +28,14 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_reduce.h>
 
+#include "collide/rules.hpp"
+
 namespace collide {
 namespace {
 
-constexpr double kUnitTolerance = 1e-4;
+/// |q| and |n| must be 1 within the tolerance of the scene files
+/// (rules.hpp): the law normalises them.
+constexpr double kUnitTolerance = kNormalTolerance;
 
 template <class T>
 Validation fail(const char* view, const char* field, std::size_t i, T value, const char* what) {
@@ -147,24 +151,25 @@ std::vector<BodyField<T>> fields_of(const PackedView<PackedParticle<T>>& b) {
           f("v.z", &r->v[2], false)};
 }
 
-/// |q| in double, as the scan measures it.
+/// |q| in double, as the scan measures it (rules.hpp's length_in_double).
 template <class T>
 double quaternion_norm(T w, T x, T y, T z) {
-  return std::sqrt(double(w) * w + double(x) * x + double(y) * y + double(z) * z);
+  const T q[4] = {w, x, y, z};
+  return length_in_double(q, 4);
 }
 
 /// The unit quaternion of the rigid model; other models have none.
 template <class T>
 Validation check_orientation(const BodyView<T>& b, std::size_t i) {
   const double qn = quaternion_norm(b.q.w[i], b.q.x[i], b.q.y[i], b.q.z[i]);
-  if (std::abs(qn - 1.0) > kUnitTolerance) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-4");
+  if (!unit_length_ok(qn)) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-3");
   return {};
 }
 template <class T>
 Validation check_orientation(const PackedView<PackedRigid<T>>& b, std::size_t i) {
   const T* q = b.bodies[i].q;
   const double qn = quaternion_norm(q[0], q[1], q[2], q[3]);
-  if (std::abs(qn - 1.0) > kUnitTolerance) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-4");
+  if (!unit_length_ok(qn)) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-3");
   return {};
 }
 template <class View>
@@ -260,10 +265,10 @@ bool screen_unit_interval(const T* x, std::size_t n) {
   return ok;
 }
 
-/// The squared norm band the unit screens accept: 1 - 0.99e-4 <= |x| <= 1 +
-/// 0.99e-4. The norm is summed in T; in float its rounding (< 4e-7 of the
-/// sum) moves |x| by less than 2e-7, inside the 1e-6 between this band and
-/// the scan's tolerance of 1e-4.
+/// The squared norm band the unit screens accept: 1 - 0.99e-3 <= |x| <= 1 +
+/// 0.99e-3. The norm is summed in T; in float its rounding (< 4e-7 of the
+/// sum) moves |x| by less than 2e-7, inside the 1e-5 between this band and
+/// the scan's tolerance of 1e-3.
 constexpr double kUnitScreenLow = (1 - 0.99 * kUnitTolerance) * (1 - 0.99 * kUnitTolerance);
 constexpr double kUnitScreenHigh = (1 + 0.99 * kUnitTolerance) * (1 + 0.99 * kUnitTolerance);
 
@@ -486,9 +491,9 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
     for (const auto& [name, a] : finite) {
       if (a != nullptr && !std::isfinite(a[k])) return fail("contacts", name, k, a[k], "must be finite");
     }
-    const double nn = std::sqrt(double(contacts.n.x[k]) * contacts.n.x[k] + double(contacts.n.y[k]) * contacts.n.y[k] +
-                                double(contacts.n.z[k]) * contacts.n.z[k]);
-    if (std::abs(nn - 1.0) > kUnitTolerance) return fail("contacts", "|n|", k, nn, "must be 1 within 1e-4");
+    const T n[3] = {contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]};
+    const double nn = length_in_double(n, 3);
+    if (!unit_length_ok(nn)) return fail("contacts", "|n|", k, nn, "must be 1 within 1e-3");
     if (contacts.e && !(contacts.e[k] >= T(0) && contacts.e[k] <= T(1))) {
       return fail("contacts", "e", k, contacts.e[k], "must be in [0, 1]");
     }

@@ -137,8 +137,10 @@ def read_scene(bodies_csv, contacts_csv, dtype=_np.float64):
 
 def write_scene(bodies_csv, contacts_csv, bodies, contacts):
     """Writes the scene in the file format (masses and moments as 1/inverse,
-    inf for 0). Both files are replaced atomically, or neither. Packed bodies
-    are unpacked first (an exact copy)."""
+    inf for 0; every number the shortest text that reads back to the same
+    value) with the library's writers, in parallel blocks, without the GIL.
+    Both files are replaced atomically, or neither. Packed bodies are
+    unpacked first (an exact copy)."""
     if isinstance(bodies, PackedBodies):
         bodies = bodies.unpack()
     _collide.write_scene(str(bodies_csv), str(contacts_csv), bodies, contacts)
@@ -148,7 +150,14 @@ def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
     """Bodies from physical units: mass m (N,) (inf = immovable), principal
     moments ``inertia`` (3, N) (inf = no rotation about that axis), any
     non-zero quaternion q (4, N) (stored as given; the law normalises it),
-    p, v, w (3, N); v and w default to zero. Array-likes are converted to ``dtype``; the result owns new arrays."""
+    p, v, w (3, N); v and w default to zero. Array-likes are converted to
+    ``dtype``; the result owns new arrays.
+
+    Every body must obey the input rules of the scene files, in ``dtype``
+    (the library's collide/rules.hpp: no NaN, inf only in m and inertia,
+    m and the moments > 0 with a finite inverse, |q|^2 a normal number):
+    ValueError("from_physical: body 3, column 'm': mass must be > 0, got -1"),
+    the reason :func:`read_scene` gives for the same value in a file."""
     dt = _np.dtype(dtype)
 
     def arr(x, rows):

@@ -56,6 +56,7 @@
 #include "collide/packed.hpp"
 #include "collide/reference.hpp"
 #include "collide/report.hpp"
+#include "collide/rules.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
 #include "collide/schedule.hpp"
@@ -199,6 +200,18 @@ struct Bodies {
             vec3<T>(w)};
   }
 };
+
+/// The read-only form of a body view.
+template <class T>
+BodyView<const T> const_view(const BodyView<T>& b) {
+  return {b.count,
+          b.inv_mass,
+          {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z},
+          {b.q.w, b.q.x, b.q.y, b.q.z},
+          {b.p.x, b.p.y, b.p.z},
+          {b.v.x, b.v.y, b.v.z},
+          {b.w.x, b.w.y, b.w.z}};
+}
 
 struct Contacts {
   py::array a, b, c, n;
@@ -849,13 +862,7 @@ std::shared_ptr<Reference> reference_t(const Bodies& bodies, const Contacts& con
   const ContactView<T> cv = contacts.view<T>();
   {
     py::gil_scoped_release release;
-    r->after = convert_bodies<long double>(BodyView<const T>{bv.count,
-                                                             bv.inv_mass,
-                                                             {bv.inv_inertia.x, bv.inv_inertia.y, bv.inv_inertia.z},
-                                                             {bv.q.w, bv.q.x, bv.q.y, bv.q.z},
-                                                             {bv.p.x, bv.p.y, bv.p.z},
-                                                             {bv.v.x, bv.v.y, bv.v.z},
-                                                             {bv.w.x, bv.w.y, bv.w.z}});
+    r->after = convert_bodies<long double>(const_view(bv));
     const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
     r->impulses.resize(contacts.count);
     r->diagnostics.resize(contacts.count);
@@ -1001,20 +1008,19 @@ void write_scene_t(const std::string& bodies_csv, const std::string& contacts_cs
   const ContactView<T> cv = contacts.view<T>();
   ImpulseBuffer<T> scratch(contacts.count);
   validate_or_throw<T>(bodies, contacts, scratch.view());
-  py::gil_scoped_release release;
-  // Physical units from the inverses (BodyBuffer::record: 1/0 gives inf).
-  const BodyBuffer<T> copy = convert_bodies<T>(bv);
-  std::string btext(bodies_header());
-  for (std::size_t i = 0; i < copy.size(); ++i) append_body_row(btext, copy.record(i));
-  ContactBuffer<T> cb;
-  cb.assign_exact(cv);
-  std::string ctext(contacts_header());
-  for (std::size_t k = 0; k < cb.size(); ++k) append_contact_row(ctext, cb.record(k));
-  OutputFile ob(bodies_csv), oc(contacts_csv);
-  ob.write(btext);
-  oc.write(ctext);
-  ob.commit();
-  oc.commit();
+  translate_io([&] {
+    py::gil_scoped_release release;
+    // Physical units from the inverses (1/0 gives inf), written by the
+    // library's writers: rows formatted in parallel blocks, a few blocks in
+    // memory at a time.
+    const BodyTable<T> table = to_body_table(const_view(bv));
+    OutputFile ob(bodies_csv), oc(contacts_csv);
+    write_body_table(ob, table);
+    write_contacts(oc, cv);
+    ob.commit();
+    oc.commit();
+    return 0;
+  });
 }
 
 void write_scene_py(const std::string& bodies_csv, const std::string& contacts_csv, const Bodies& bodies,
@@ -1029,7 +1035,9 @@ void write_scene_py(const std::string& bodies_csv, const std::string& contacts_c
 
 /// Bodies from physical units: mass (inf = immovable), principal moments
 /// (inf = no rotation about that axis), any non-zero quaternion (normalised),
-/// as BodyBuffer::set stores them.
+/// as BodyBuffer::set stores them. Each body is checked with the library's
+/// rules (collide/rules.hpp): ValueError("from_physical: body 3, column 'm':
+/// mass must be > 0, got -1"), the reason the scene reader gives.
 py::object from_physical_py(const py::object& m_in, const py::object& inertia_in, const py::object& q_in,
                             const py::object& p_in, const py::object& v_in, const py::object& w_in,
                             const py::object& dtype_in) {
@@ -1055,27 +1063,16 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
     for (std::size_t i = 0; i < n; ++i) {
       BodyRecord<T> r;
       r.m = pm[i];
-      if (!(r.m > T(0))) {
-        throw py::value_error("from_physical: m[" + std::to_string(i) + "] = " + std::to_string(r.m) +
-                              ": must be > 0 (inf = immovable)");
-      }
       for (int k = 0; k < 3; ++k) {
         r.I[k] = pI[k * n + i];
-        if (!(r.I[k] > T(0))) {
-          throw py::value_error("from_physical: inertia[" + std::to_string(k) + ", " + std::to_string(i) +
-                                "] = " + std::to_string(r.I[k]) + ": must be > 0 (inf = locked axis)");
-        }
         r.p[k] = pp[k * n + i];
         r.v[k] = pv[k * n + i];
         r.w[k] = pw[k * n + i];
       }
-      T qn = 0;
-      for (int k = 0; k < 4; ++k) {
-        r.q[k] = pq[k * n + i];
-        qn += r.q[k] * r.q[k];
-      }
-      if (!(qn > T(0)) || !std::isfinite(qn)) {
-        throw py::value_error("from_physical: q[:, " + std::to_string(i) + "]: must be finite and non-zero");
+      for (int k = 0; k < 4; ++k) r.q[k] = pq[k * n + i];
+      if (const std::optional<Defect> defect = body_defect(r)) {
+        throw py::value_error(owner + ": body " + std::to_string(i) + ", column '" + std::string(defect->column) +
+                              "': " + defect->reason);
       }
       buffer.set(i, r);
     }

@@ -134,10 +134,13 @@ TEST(SceneIo, FloatRangeIsCheckedInFloat) {
   const SceneError m = expect_scene_error(
       [] { (void)collide::parse_bodies<float>(kHeader + "1e-45,1,1,1,1,0,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"); });
   EXPECT_EQ(m.column(), "m");
+  EXPECT_EQ(m.reason(), "mass 1e-45 is too small: its inverse overflows float");
   // A quaternion that cannot be normalised in float.
   const SceneError q = expect_scene_error(
       [] { (void)collide::parse_bodies<float>(kHeader + "2,1,1,1,1e-25,1e-25,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"); });
   EXPECT_EQ(q.column(), "qw");
+  EXPECT_EQ(q.reason(),
+            "quaternion cannot be normalised in float: it is too close to zero (qw, qx, qy, qz = 1e-25, 1e-25, 0, 0)");
   EXPECT_NO_THROW((void)collide::parse_bodies<double>(kHeader + "2,1,1,1,1e-25,1e-25,0,0,0,1,0,0.5,-3,0,0,0,1\n", "b"));
 }
 
@@ -385,6 +388,60 @@ TEST_F(OutputFileTest, CommitReplacesAtomically) {
   }
   EXPECT_EQ(collide::read_file((dir_ / "out.csv").string()), "new");
   EXPECT_EQ(entries(), 1u);
+}
+
+// The scene writers (write_body_table, write_contacts) format rows in
+// parallel blocks: their bytes are those of the one-row formatters
+// (append_body_row, append_contact_row) over the whole scene, across more
+// than one block, and the file is the in-memory text.
+template <class T>
+void expect_writers_match_row_formatters(const fs::path& dir) {
+  collide::GenerateOptions o;
+  o.friction = true;
+  const collide::Scene<T> s = collide::generate_debris<T>(40000, o);  // 40000 contacts, 20001 bodies: 3 and 2 blocks
+  const auto bodies = std::as_const(s.bodies).view();
+  const collide::ContactView<T> contacts = s.contacts.view();
+  ASSERT_GT(bodies.count, 16384u);
+
+  std::string expected_bodies(collide::bodies_header());
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) collide::append_body_row(expected_bodies, s.bodies.record(i));
+  std::string expected_contacts(collide::contacts_header());
+  for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+    collide::append_contact_row(expected_contacts, s.contacts.record(k));
+  }
+  const BodyTable<T> table = collide::to_body_table(bodies);
+  EXPECT_EQ(collide::format_body_table(table), expected_bodies);
+  EXPECT_EQ(collide::format_contacts(contacts), expected_contacts);
+
+  const std::string b = (dir / "bodies.csv").string(), c = (dir / "contacts.csv").string();
+  {
+    collide::OutputFile ob(b), oc(c);
+    collide::write_body_table(ob, table);
+    collide::write_contacts(oc, contacts);
+    ob.commit();
+    oc.commit();
+  }
+  EXPECT_EQ(collide::read_file(b), expected_bodies);
+  EXPECT_EQ(collide::read_file(c), expected_contacts);
+
+  // Without per-contact e and mu: uniform_e and 0 in every row.
+  collide::ContactView<T> plain = contacts;
+  plain.e = nullptr;
+  plain.uniform_e = T(0.25);
+  plain.mu = nullptr;
+  std::string expected_plain(collide::contacts_header());
+  for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+    collide::ContactRecord<T> r = s.contacts.record(k);
+    r.e = T(0.25);
+    r.mu = T(0);
+    collide::append_contact_row(expected_plain, r);
+  }
+  EXPECT_EQ(collide::format_contacts(plain), expected_plain);
+}
+
+TEST_F(OutputFileTest, SceneWritersMatchTheRowFormatters) {
+  expect_writers_match_row_formatters<float>(dir_);
+  expect_writers_match_row_formatters<double>(dir_);
 }
 
 TEST_F(OutputFileTest, MissingDirectoryIsASceneError) {

@@ -10,13 +10,15 @@
 //   set() overwrites one body, resize() makes identity-oriented bodies.
 // * ContactBuffer normalises n, copies everything else bit for bit; its view
 //   drops mu (frictionless) exactly when every mu is 0; record() and set()
-//   round-trip.
+//   round-trip. A normal off unit by more than the files' tolerance is
+//   refused (every rule is test_rules.cpp's).
 // * convert_scene / convert_bodies / convert_contacts copy values exactly,
 //   with no renormalisation: float -> long double -> float is the identity
 //   bit for bit, a view without e gives uniform_e in every row, a view
 //   without mu gives mu = 0.
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -102,9 +104,13 @@ TYPED_TEST(SceneBuffers, ContactPushBackStoresTheNormalAsGiven) {
   r.a = 3;
   r.b = 7;
   r.c[0] = T(-0.0), r.c[1] = T(1.5), r.c[2] = T(2);
-  r.n[0] = 0, r.n[1] = 0, r.n[2] = T(1.0005);  // unit within the tolerance only
+  // A normal must be unit within kNormalTolerance (collide/rules.hpp).
+  r.n[0] = 0, r.n[1] = 0, r.n[2] = 2;
   r.e = T(0.25);
   r.mu = 0;
+  EXPECT_THROW(c.push_back(r), std::invalid_argument);
+  EXPECT_EQ(c.size(), 0u);
+  r.n[2] = T(1.0005);
   c.push_back(r);
   r.n[0] = 0, r.n[1] = T(0.6), r.n[2] = T(0.8);
   c.push_back(r);

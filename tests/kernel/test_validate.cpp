@@ -8,8 +8,9 @@
 // * Every rule of validate.hpp rejects what it should, and the message names
 //   the view, the field and the element: impulses.count != contacts.count,
 //   null arrays, negative / NaN / inf inverse mass and moments, non-finite
-//   q, p, v, w, c, n, |q| or |n| off 1 by more than 1e-4 (within 1e-4 is
-//   accepted), indices out of range, a contact of a body with itself, e
+//   q, p, v, w, c, n, |q| or |n| off 1 by more than 1e-3 (kNormalTolerance of
+//   rules.hpp, the scene files' rule; within it is accepted, on both sides of
+//   the boundary), indices out of range, a contact of a body with itself, e
 //   outside [0, 1] (per contact and uniform), mu negative or not finite.
 // * The first problem in array order is the one reported.
 // * The vectorised screen that runs first (validate.cpp) changes no verdict:
@@ -29,6 +30,7 @@
 #include <gtest/gtest.h>
 
 #include "collide/packed.hpp"
+#include "collide/rules.hpp"
 #include "collide/validate.hpp"
 #include "support/scenes.hpp"
 #include "support/solve_helpers.hpp"
@@ -149,12 +151,39 @@ TYPED_TEST(Validate, EachRuleRejectsAndNamesTheElement) {
   }
 }
 
-TYPED_TEST(Validate, UnitToleranceIsOneInTenThousand) {
-  using T = TypeParam;
+/// The fixture with |q| of body 5 scaled by `q_scale` and |n| of contact 2
+/// by `n_scale`: its verdict.
+template <class T>
+Validation scaled_units(double q_scale, double n_scale) {
   Fixture<T> f;
-  for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(1 + 5e-5);
-  for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(1 - 5e-5);
-  EXPECT_TRUE(f.run()) << f.run().message;
+  for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(q_scale);
+  for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(n_scale);
+  return f.run();
+}
+
+TYPED_TEST(Validate, UnitToleranceIsOneInAThousand) {
+  using T = TypeParam;
+  static_assert(kNormalTolerance == 1e-3);
+  // Inside: what the scene files accept (0.5e-3 off, and just inside the
+  // boundary on both sides; the stored values are unit to a few ulps of T,
+  // far below the 1e-6 left).
+  for (const double off : {5e-5, 5e-4, 0.999e-3}) {
+    for (const double sign : {1.0, -1.0}) {
+      const Validation v = scaled_units<T>(1 + sign * off, 1 - sign * off);
+      EXPECT_TRUE(v) << "off by " << sign * off << ": " << v.message;
+    }
+  }
+  // Outside: just past the boundary on both sides, and 2e-3.
+  for (const double off : {1.001e-3, 2e-3}) {
+    for (const double sign : {1.0, -1.0}) {
+      Validation v = scaled_units<T>(1 + sign * off, 1);
+      EXPECT_NE(v.message.find("bodies.|q|[5]"), std::string::npos) << "off by " << sign * off << ": " << v.message;
+      EXPECT_NE(v.message.find("must be 1 within 1e-3"), std::string::npos) << v.message;
+      v = scaled_units<T>(1, 1 + sign * off);
+      EXPECT_NE(v.message.find("contacts.|n|[2]"), std::string::npos) << "off by " << sign * off << ": " << v.message;
+      EXPECT_NE(v.message.find("must be 1 within 1e-3"), std::string::npos) << v.message;
+    }
+  }
 }
 
 TYPED_TEST(Validate, FirstProblemIsReported) {
@@ -205,14 +234,14 @@ TYPED_TEST(Validate, ScreenChangesNoVerdict) {
   f.bodies.inv_mass[3] = -T(0);  // fails the screen's sign test; the rule (>= 0) accepts it
   f.bodies.inv_inertia.y[4] = -T(0);
   EXPECT_TRUE(f.run()) << f.run().message;
-  // Off 1 by 0.995e-4: outside the screen's band (0.99e-4), inside the rule's 1e-4.
-  for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(1 + 0.995e-4);
-  for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(1 - 0.995e-4);
+  // Off 1 by 0.995e-3: outside the screen's band (0.99e-3), inside the rule's 1e-3.
+  for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(1 + 0.995e-3);
+  for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(1 - 0.995e-3);
   EXPECT_TRUE(f.run()) << f.run().message;
   // Just outside the rule, with every other value inside the screen's band
   // (so no other screen failure sends the scene to the scan).
   Fixture<T> g;
-  for (T* q : {g.bodies.q.w, g.bodies.q.x, g.bodies.q.y, g.bodies.q.z}) q[5] *= T(1 + 1.005e-4);
+  for (T* q : {g.bodies.q.w, g.bodies.q.x, g.bodies.q.y, g.bodies.q.z}) q[5] *= T(1 + 1.005e-3);
   EXPECT_NE(g.run().message.find("bodies.|q|[5]"), std::string::npos) << g.run().message;
 }
 

@@ -122,9 +122,14 @@ class BodyBuffer {
 
   /// Appends a body given in physical units: stores 1/m and 1/I (0 for inf),
   /// zeroes the inverse moments of an immovable body and keeps q as given
-  /// (the kernels normalise it, as the law says).
+  /// (the kernels normalise it, as the law says). A body that breaks a rule
+  /// of collide/rules.hpp is refused, nothing stored:
+  /// std::invalid_argument("collide::BodyBuffer::push_back: body 3,
+  /// column 'm': mass must be > 0, got -1"). (Tests that need a poisoned
+  /// value in a kernel write it through view() afterwards.)
   void push_back(const BodyRecord<T>& body);
-  /// Writes body i from physical units, as push_back does.
+  /// Writes body i from physical units, as push_back does (and refuses what
+  /// push_back refuses, naming "collide::BodyBuffer::set").
   void set(std::size_t i, const BodyRecord<T>& body);
   /// Reads body i back in physical units (1/0 gives inf).
   [[nodiscard]] BodyRecord<T> record(std::size_t i) const;

@@ -79,7 +79,14 @@ class ContactBuffer {
   void reserve(std::size_t n);
   [[nodiscard]] std::size_t size() const { return a_.size(); }
 
+  /// Appends a contact. One that breaks a rule of collide/rules.hpp (NaN,
+  /// inf, |n| not 1 within kNormalTolerance, e outside [0, 1], mu < 0,
+  /// a == b; ids are not checked against a body count, which the buffer does
+  /// not know) is refused, nothing stored: std::invalid_argument(
+  /// "collide::ContactBuffer::push_back: contact 3, column 'e': ...").
   void push_back(const ContactRecord<T>& contact);
+  /// Writes contact i, as push_back does (std::invalid_argument naming
+  /// "collide::ContactBuffer::set").
   void set(std::size_t i, const ContactRecord<T>& contact);
   [[nodiscard]] ContactRecord<T> record(std::size_t i) const;
 

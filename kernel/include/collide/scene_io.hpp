@@ -10,10 +10,15 @@
 //   table and the solved velocities.
 // * Every bad input of the spec is a SceneError whose message names the file,
 //   the 1-based line, the 0-based data row (the body or contact id) and the
-//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got '-1'".
-//   The checks run on the parsed T values, so a value that is fine in double
-//   but unusable in float (1e39, a quaternion too small to normalise) is
-//   rejected with the precision named.
+//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got -1".
+//   What the text itself gets wrong (not a number, an empty field, a missing
+//   or extra column, a value out of the range of T) is the reader's to say;
+//   a row whose every field parses is then checked with the rules of
+//   collide/rules.hpp, on the parsed T values, and the reason is theirs, the
+//   same text the buffers and the Python constructors give for the same
+//   value. So a value that is fine in double but unusable in float (1e39, a
+//   mass of 1e-45, a quaternion too small to normalise) is rejected with the
+//   precision named. A row with both kinds of defect reports the text one.
 // * The parse-from-memory entry points (`parse_bodies`, `parse_contacts`)
 //   take the text and a file name for the messages, so fuzzers and tests can
 //   drive the parser without files.
@@ -40,20 +45,15 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/output_file.hpp"
+#include "collide/rules.hpp"
 
 namespace collide {
 
-/// Columns of bodies.csv, in file order.
-inline constexpr std::array<std::string_view, 17> kBodyColumns = {"m",  "Ix", "Iy", "Iz", "qw", "qx", "qy", "qz", "px",
-                                                                  "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz"};
-/// Columns of contacts.csv, in file order.
-inline constexpr std::array<std::string_view, 10> kContactColumns = {"a",  "b",  "cx", "cy", "cz",
-                                                                     "nx", "ny", "nz", "e",  "mu"};
+// kBodyColumns, kContactColumns (the columns of bodies.csv and contacts.csv)
+// and kNormalTolerance come from collide/rules.hpp.
+
 /// Columns of the impulses file.
 inline constexpr std::array<std::string_view, 3> kImpulseColumns = {"jx", "jy", "jz"};
-
-/// Allowed deviation of |n| from 1 before n is normalised.
-inline constexpr double kNormalTolerance = 1e-3;
 
 /// A scene file that cannot be read or written. For a bad value, line() is
 /// the 1-based line, row() the 0-based data row (body or contact id) and
@@ -117,9 +117,15 @@ BodyTable<T> parse_bodies(std::string_view text, std::string_view file_name);
 template <class T>
 BodyTable<T> read_bodies(const std::string& path);
 
-/// Converts a table into what the kernels consume (1/m, 1/I, unit q).
+/// Converts a table into what the kernels consume (1/m, 1/I, unit q),
+/// through BodyBuffer::set (std::invalid_argument for a body that breaks a
+/// rule; a table from parse_bodies has none).
 template <class T>
 BodyBuffer<T> to_body_buffer(const BodyTable<T>& table);
+/// The other way: a kernel view in physical units (1/x, inf for 0), what
+/// write_body_table writes as a scene file.
+template <class T>
+BodyTable<T> to_body_table(const BodyView<const T>& bodies);
 
 /// Parses the text of a contacts file whose ids refer to `body_count` bodies.
 /// |n| is checked against 1 within kNormalTolerance before n is normalised.
@@ -146,12 +152,20 @@ void write_impulses(OutputFile& out, const ImpulseView<const T>& impulses);
 /// Writes a body table as it is (a scene input file).
 template <class T>
 void write_body_table(OutputFile& out, const BodyTable<T>& table);
+/// Writes contacts as a contacts file (a scene input file), values as given;
+/// a view without e gets uniform_e in every row, one without mu gets 0.
+template <class T>
+void write_contacts(OutputFile& out, const ContactView<T>& contacts);
 
 /// In-memory forms of the writers above: the complete file text.
 template <class T>
 std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved);
 template <class T>
 std::string format_impulses(const ImpulseView<const T>& impulses);
+template <class T>
+std::string format_body_table(const BodyTable<T>& table);
+template <class T>
+std::string format_contacts(const ContactView<T>& contacts);
 
 /// Header lines, newline included.
 std::string_view bodies_header();

@@ -3,8 +3,10 @@
 // The kernels trust their input: in release builds they check nothing, in
 // debug builds they assert the cheap preconditions (index range, a != b, view
 // sizes). A caller that hands over its own arrays calls validate() at the
-// boundary, once per scene or whenever the data may be bad; the CLI's file
-// reader applies the stricter scene-file rules of docs/collision-law.md.
+// boundary, once per scene or whenever the data may be bad. The views hold
+// inverse units; the rules for physical units (what a scene file or a
+// BodyRecord holds: m > 0, 1/m finite, ...) are collide/rules.hpp's, which
+// the file reader and the buffers apply. The unit tolerance is the same.
 #pragma once
 
 #include <string>
@@ -27,8 +29,10 @@ struct Validation {
 ///  * impulses.count == contacts.count;
 ///  * contact indices < bodies.count and a != b;
 ///  * inverse mass and inverse moments finite and >= 0;
-///  * q, p, v, w, c, n finite; |q| and |n| equal to 1 within 1e-4 (the
-///    kernels do not renormalise);
+///  * q, p, v, w, c, n finite; |q| and |n| equal to 1 within
+///    kNormalTolerance (1e-3, collide/rules.hpp: the scene files' rule for
+///    n; the law normalises both, so the kernels take them as given within
+///    it), |q| and |n| measured in double;
 ///  * e in [0, 1] (per contact, or uniform_e), mu finite and >= 0.
 template <class T>
 Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
