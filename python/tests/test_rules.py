@@ -121,7 +121,7 @@ def test_from_physical_accepts_the_edges():
     v = np.full((3, 3), np.float32(1e-40))  # subnormal: finite, allowed
     bodies = collide.from_physical(m, inertia, q, p, v, dtype=np.float32)
     assert list(bodies.inv_mass) == [0.0, np.float32(1) / np.float32(1e-30), 0.5]
-    assert list(bodies.q[:, 0]) == [1.0, 0.0, 0.0, 0.0]
+    assert list(bodies.q[:, 0]) == [2.0, 0.0, 0.0, 0.0]  # as given: the law normalises q
 
 
 # ---------------------------------------------------------------------------

@@ -8,13 +8,14 @@
 // * Every rule of validate.hpp rejects what it should, and the message names
 //   the view, the field and the element: impulses.count != contacts.count,
 //   null arrays, negative / NaN / inf inverse mass and moments, non-finite
-//   q, p, v, w, c, n, |q| or |n| off 1 by more than 1e-3 (kNormalTolerance of
+//   q, p, v, w, c, n, |n| off 1 by more than 1e-3 (kNormalTolerance of
 //   rules.hpp, the scene files' rule; within it is accepted, on both sides of
-//   the boundary), indices out of range, a contact of a body with itself, e
+//   the boundary), a quaternion whose |q|^2 is not a normal, finite number
+//   (the files' rule; any other length is accepted), indices out of range, a contact of a body with itself, e
 //   outside [0, 1] (per contact and uniform), mu negative or not finite.
 // * The first problem in array order is the one reported.
 // * The vectorised screen that runs first (validate.cpp) changes no verdict:
-//   -0.0 inverse masses and |q| just inside the tolerance (which fail the
+//   -0.0 inverse masses and |n| just inside the tolerance (which fail the
 //   screen) pass through the scan; a bad value in the last element of a scene
 //   large enough to be screened in parallel chunks is still found and named.
 // * Packed records (collide/packed.hpp) get the verdict and the message of the
@@ -108,10 +109,17 @@ std::vector<Rule<T>> rules() {
       {"bodies.inv_inertia.y[4]", [=](Fixture<T>& f) { f.bodies.inv_inertia.y[4] = nan; }},
       {"bodies.inv_inertia.z[4]", [](Fixture<T>& f) { f.bodies.inv_inertia.z[4] = -T(0.5); }},
       {"bodies.q.x[5]", [=](Fixture<T>& f) { f.bodies.q.x[5] = inf; }},
-      {"bodies.|q|[5]",
+      {"bodies.|q|^2[5]",  // too small to normalise in T: |q|^2 below the smallest normal
        [](Fixture<T>& f) {
-         for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(1.01);
+         for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] = 0;
+         f.bodies.q.w[5] = std::sqrt(std::numeric_limits<T>::min()) / 2;
        }},
+      {"bodies.|q|^2[5]",  // zero
+       [](Fixture<T>& f) {
+         for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] = 0;
+       }},
+      {"bodies.|q|^2[5]",  // |q|^2 overflows
+       [](Fixture<T>& f) { f.bodies.q.w[5] = std::sqrt(std::numeric_limits<T>::max()) * 2; }},
       {"bodies.p.z[6]", [=](Fixture<T>& f) { f.bodies.p.z[6] = nan; }},
       {"bodies.v.x[7]", [=](Fixture<T>& f) { f.bodies.v.x[7] = -inf; }},
       {"bodies.w.y[8]", [=](Fixture<T>& f) { f.bodies.w.y[8] = nan; }},
@@ -161,25 +169,26 @@ Validation scaled_units(double q_scale, double n_scale) {
   return f.run();
 }
 
-TYPED_TEST(Validate, UnitToleranceIsOneInAThousand) {
+TYPED_TEST(Validate, NormalToleranceIsOneInAThousandAndQuaternionsAnyLength) {
   using T = TypeParam;
   static_assert(kNormalTolerance == 1e-3);
   // Inside: what the scene files accept (0.5e-3 off, and just inside the
   // boundary on both sides; the stored values are unit to a few ulps of T,
-  // far below the 1e-6 left).
+  // far below the 1e-6 left). The law normalises q, so its length is free.
   for (const double off : {5e-5, 5e-4, 0.999e-3}) {
     for (const double sign : {1.0, -1.0}) {
       const Validation v = scaled_units<T>(1 + sign * off, 1 - sign * off);
       EXPECT_TRUE(v) << "off by " << sign * off << ": " << v.message;
     }
   }
+  for (const double q_scale : {0.5, 1.01, 2.0, 1e6}) {
+    const Validation v = scaled_units<T>(q_scale, 1);
+    EXPECT_TRUE(v) << "|q| scaled by " << q_scale << ": " << v.message;
+  }
   // Outside: just past the boundary on both sides, and 2e-3.
   for (const double off : {1.001e-3, 2e-3}) {
     for (const double sign : {1.0, -1.0}) {
-      Validation v = scaled_units<T>(1 + sign * off, 1);
-      EXPECT_NE(v.message.find("bodies.|q|[5]"), std::string::npos) << "off by " << sign * off << ": " << v.message;
-      EXPECT_NE(v.message.find("must be 1 within 1e-3"), std::string::npos) << v.message;
-      v = scaled_units<T>(1, 1 + sign * off);
+      const Validation v = scaled_units<T>(1, 1 + sign * off);
       EXPECT_NE(v.message.find("contacts.|n|[2]"), std::string::npos) << "off by " << sign * off << ": " << v.message;
       EXPECT_NE(v.message.find("must be 1 within 1e-3"), std::string::npos) << v.message;
     }
@@ -205,7 +214,9 @@ TYPED_TEST(Validate, SphereAndParticleViews) {
   EXPECT_TRUE(validate(sphere_view(f.bodies), f.contacts, f.impulses));
   EXPECT_TRUE(validate(particle_view(f.bodies), f.contacts, f.impulses));
 
-  f.bodies.q.w[3] = T(7);  // not unit, but neither model reads q
+  // A zero quaternion breaks the rigid model's rule, but neither smaller
+  // model reads q.
+  for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[3] = T(0);
   EXPECT_FALSE(f.run());
   EXPECT_TRUE(validate(sphere_view(f.bodies), f.contacts, f.impulses));
   EXPECT_TRUE(validate(particle_view(f.bodies), f.contacts, f.impulses));
@@ -238,11 +249,19 @@ TYPED_TEST(Validate, ScreenChangesNoVerdict) {
   for (T* q : {f.bodies.q.w, f.bodies.q.x, f.bodies.q.y, f.bodies.q.z}) q[5] *= T(1 + 0.995e-3);
   for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(1 - 0.995e-3);
   EXPECT_TRUE(f.run()) << f.run().message;
-  // Just outside the rule, with every other value inside the screen's band
-  // (so no other screen failure sends the scene to the scan).
+  // Just outside the rules, with every other value inside the screens (so
+  // no other screen failure sends the scene to the scan): a normal off by
+  // 1.005e-3, then a quaternion whose |q|^2 is just below the smallest
+  // normal number while just above it passes.
   Fixture<T> g;
-  for (T* q : {g.bodies.q.w, g.bodies.q.x, g.bodies.q.y, g.bodies.q.z}) q[5] *= T(1 + 1.005e-3);
-  EXPECT_NE(g.run().message.find("bodies.|q|[5]"), std::string::npos) << g.run().message;
+  for (const T* n : {g.contacts.n.x, g.contacts.n.y, g.contacts.n.z}) mut(n)[2] *= T(1 + 1.005e-3);
+  EXPECT_NE(g.run().message.find("contacts.|n|[2]"), std::string::npos) << g.run().message;
+  Fixture<T> h;
+  for (T* q : {h.bodies.q.x, h.bodies.q.y, h.bodies.q.z}) q[5] = 0;
+  h.bodies.q.w[5] = std::sqrt(std::numeric_limits<T>::min()) * T(1.5);
+  EXPECT_TRUE(h.run()) << h.run().message;
+  h.bodies.q.w[5] = std::sqrt(std::numeric_limits<T>::min()) * T(0.5);
+  EXPECT_NE(h.run().message.find("bodies.|q|^2[5]"), std::string::npos) << h.run().message;
 }
 
 // Above 64k elements the screens run in parallel chunks: a problem in the last

@@ -42,6 +42,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -58,7 +59,7 @@ inline constexpr std::array<std::string_view, 17> kBodyColumns = {"m",  "Ix", "I
 inline constexpr std::array<std::string_view, 10> kContactColumns = {"a",  "b",  "cx", "cy", "cz",
                                                                      "nx", "ny", "nz", "e",  "mu"};
 
-/// Allowed deviation of |n| (and, in kernel views, |q|) from 1.
+/// Allowed deviation of |n| from 1.
 inline constexpr double kNormalTolerance = 1e-3;
 
 /// No body count to check ids against (a != b is still checked).
@@ -90,6 +91,21 @@ bool contact_ok(const ContactRecord<T>& contact, std::size_t body_count = kUnkno
 /// 0 to 2)". contact_defect's text; the reader's too for ids too large for
 /// BodyIndex.
 std::string body_id_out_of_range(std::string_view id, std::size_t body_count);
+
+/// |q|^2 summed in T in the kernels' order, ((w^2 + x^2) + y^2) + z^2.
+template <class T>
+T quaternion_square(T w, T x, T y, T z) noexcept {
+  return ((w * w + x * x) + y * y) + z * z;
+}
+
+/// The quaternion rule: q / |q| can be formed in T, i.e. quaternion_square
+/// is a normal, finite number (false for a zero q, NaN, or a q too small or
+/// too large). The scene files and validate() apply it alike.
+template <class T>
+bool quaternion_normalisable(T w, T x, T y, T z) noexcept {
+  const T q2 = quaternion_square(w, x, y, z);
+  return std::isfinite(q2) && q2 >= std::numeric_limits<T>::min();
+}
 
 /// Whether a length is 1 within kNormalTolerance (false for NaN).
 inline bool unit_length_ok(double length) { return std::fabs(length - 1.0) <= kNormalTolerance; }

@@ -29,10 +29,10 @@ struct Validation {
 ///  * impulses.count == contacts.count;
 ///  * contact indices < bodies.count and a != b;
 ///  * inverse mass and inverse moments finite and >= 0;
-///  * q, p, v, w, c, n finite; |q| and |n| equal to 1 within
-///    kNormalTolerance (1e-3, collide/rules.hpp: the scene files' rule for
-///    n; the law normalises both, so the kernels take them as given within
-///    it), |q| and |n| measured in double;
+///  * q, p, v, w, c, n finite; |n| equal to 1 within kNormalTolerance
+///    (1e-3) and |q|^2 a normal, finite number in T: the scene files' rules
+///    (collide/rules.hpp). The law normalises both, and so do the kernels,
+///    so they take n and q as given within those rules;
 ///  * e in [0, 1] (per contact, or uniform_e), mu finite and >= 0.
 template <class T>
 Validation validate(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
