@@ -261,6 +261,7 @@ TEST(IsaAuto, ConcurrentFirstSolvesMeasureOnce) {
   constexpr int kThreads = 4;
   std::vector<SolveStats> stats(kThreads);
   std::vector<std::thread> threads;
+  threads.reserve(kThreads);
   for (int t = 0; t < kThreads; ++t) {
     threads.emplace_back([&, t] {
       BodyBuffer<double> bodies = scene.bodies;
