@@ -8,6 +8,9 @@
 //   then, for each scene x precision x N, one group:
 //     schedule/<scene>/<f32|f64>/n:N      Schedule::build alone
 //     solve/<scene>/<prec>/<scalar|simd>/t:{1,2}/n:N
+//     isa/<scene>/<prec>/<sse2|avx2|avx512|auto>/t:T/n:N   the SIMD path of
+//                                    every ISA the CPU has, and Isa::automatic,
+//                                    at 64Ki (t:1) and 4Mi (t:2)
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
 //   then the body-model grid at 64Ki and 4Mi:
 //     model/<scene>/<model>[+mu]/<prec>/simd/t:{1,2}/n:N
@@ -78,6 +81,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -297,7 +301,8 @@ std::string solve_name(Kind kind, const char* precision, Path path, int threads,
   return std::string("solve/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(path) +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
-/// The SIMD path of one instruction set (issue 12: every ISA the CPU has).
+/// The SIMD path of one instruction set (issue 12: every ISA the CPU has), or
+/// of Isa::automatic ("auto").
 std::string isa_name(Kind kind, const char* precision, collide::Isa isa, int threads, std::size_t n) {
   return std::string("isa/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(isa) +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
@@ -363,10 +368,19 @@ double timed_solves(
   return seconds;
 }
 
+/// Isa::automatic measures the ISAs at the first solve of each kind in a
+/// process (collide::fastest_isa): done here, before a row's timed loop, so
+/// that no row times that one-off cost.
+template <class T>
+void measure_isa_auto(collide::Model model, collide::Accuracy accuracy = collide::Accuracy::fast) {
+  for (const bool scattered : {false, true}) (void)collide::fastest_isa<T>(model, accuracy, scattered);
+}
+
 template <class T>
 void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int threads,
                collide::Isa isa = collide::Isa::automatic) {
   Prepared<T>& p = g_cache.get<T>(kind, n);
+  measure_isa_auto<T>(collide::Model::rigid);
   collide::SolverOptions options;
   options.path = path;
   options.threads = threads;
@@ -398,6 +412,7 @@ template <class T>
 void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
                collide::Accuracy accuracy = collide::Accuracy::fast) {
   Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
+  measure_isa_auto<T>(model, accuracy);
   collide::SolverOptions options;
   options.path = Path::simd;
   options.threads = threads;
@@ -478,6 +493,7 @@ template <class T>
 void layout_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
                 LayoutRow layout) {
   Prepared<T>& p = g_cache.get<T>(kind, n, model, friction);
+  measure_isa_auto<T>(model);
   collide::SolverOptions options;
   options.path = Path::simd;
   options.threads = threads;
@@ -608,10 +624,13 @@ void register_group(Kind kind, std::size_t n) {
               [=](benchmark::State& s) { solve_row<T>(s, kind, n, path, threads); });
     }
   }
-  // The SIMD path of every ISA this CPU has (the rows above run the default,
-  // the best one), in cache on 1 thread and streaming on 2.
+  // The SIMD path of every ISA this CPU has, in cache on 1 thread and
+  // streaming on 2, and beside them auto (the rows above run it too): the ISA
+  // measured fastest for the kind of solve, which should be within a few
+  // percent of the best fixed row.
   if (kind != Kind::pairs_mu && (n == 65536 || n == 4194304)) {
-    for (const collide::Isa isa : {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512}) {
+    for (const collide::Isa isa :
+         {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512, collide::Isa::automatic}) {
       if (!collide::isa_supported(isa)) continue;
       const int threads = n == 65536 ? 1 : 2;
       add_row(isa_name(kind, precision, isa, threads, n),
@@ -742,6 +761,7 @@ bool check_scene(Kind kind, std::ostream& out) {
 struct Result {
   double coll_per_s = 0, gbs = 0, bw_frac = 0;
   bool valid = false;
+  std::string label;  ///< the row's label (solve rows: "<isa>, <lanes> lanes")
 };
 
 /// Wraps the display reporter chosen by the flags and keeps each row's
@@ -769,7 +789,7 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
         const auto it = run.counters.find(name);
         return it == run.counters.end() ? 0.0 : it->second.value;
       };
-      r = Result{counter("coll/s"), counter("GB/s"), counter("bw_frac"), true};
+      r = Result{counter("coll/s"), counter("GB/s"), counter("bw_frac"), true, run.report_label};
       if (median) {
         had_median_[key] = true;
         medians_ = true;
@@ -839,8 +859,14 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
         load_before > 0.5 ? " -- other processes were running: expect noisy rows, try --benchmark_repetitions=3" : "");
   print("LLC %zu MiB; triad arrays %zu MiB each\n", llc_bytes() >> 20, collide::default_triad_array_bytes() >> 20);
   print("triad bandwidth: %.2f GB/s at 1 thread, %.2f GB/s at 2 threads\n", triad_gbs(1), triad_gbs(2));
-  print("SIMD rows run %s (the best of this CPU: %s; isa/ rows run each ISA it has)\n",
-        collide::to_string(collide::default_isa()), collide::to_string(collide::best_isa()));
+  {
+    const char* env = std::getenv("COLLIDE_ISA");
+    const std::string isa_auto = env != nullptr && *env != '\0' && std::string(env) != "auto"
+                                     ? "COLLIDE_ISA=" + std::string(env)
+                                     : "the fastest ISA per kind of solve, measured once per process";
+    print("SIMD rows run auto: %s (the widest of this CPU: %s; isa/ rows run each ISA it has, and auto)\n",
+          isa_auto.c_str(), collide::to_string(collide::best_isa()));
+  }
   if (!checks_ok) {
     print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
   }
@@ -976,6 +1002,41 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
           "   reach %.2f (%s) to %.2f (%s) of their twin's throughput)\n",
           twin_frac.low, twin_frac.high, of_twin.low, of_twin.low_name.c_str(), of_twin.high,
           of_twin.high_name.c_str());
+    }
+  }
+
+  {
+    // auto against the best fixed ISA of the same scene, precision, N and
+    // threads: every ISA gives the same bits, so auto is judged on speed only.
+    using collide::Isa;
+    bool header = false;
+    for (Kind kind : {Kind::pairs, Kind::debris}) {
+      for (const char* precision : {"f32", "f64"}) {
+        for (const auto& [n, threads] : {std::pair{cache_n, 1}, std::pair{stream_n, 2}}) {
+          const Result automatic = rep.get(isa_name(kind, precision, Isa::automatic, threads, n));
+          Isa best = Isa::automatic;
+          Result best_row;
+          for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+            const Result r = rep.get(isa_name(kind, precision, isa, threads, n));
+            if (r.valid && (!best_row.valid || r.coll_per_s > best_row.coll_per_s)) {
+              best = isa;
+              best_row = r;
+            }
+          }
+          if (!automatic.valid || !best_row.valid) continue;
+          if (!header) {
+            print("\nisa auto against the best fixed ISA (isa/ rows; target: auto >= 0.97 x best on every row)\n");
+            print("  %-7s %-4s %3s %9s  %-7s %9s  %-9s %9s  %6s\n", "scene", "prec", "t", "N", "best", "Mcoll/s",
+                  "auto ran", "Mcoll/s", "ratio");
+            header = true;
+          }
+          const std::string ran = automatic.label.substr(0, automatic.label.find(','));
+          const double r = automatic.coll_per_s / best_row.coll_per_s;
+          print("  %-7s %-4s %3d %9zu  %-7s %9.1f  %-9s %9.1f  %6.3f  %s\n", kind_name(kind), precision, threads, n,
+                collide::to_string(best), best_row.coll_per_s / 1e6, ran.c_str(), automatic.coll_per_s / 1e6, r,
+                r >= 0.97 ? "MET" : "MISSED");
+        }
+      }
     }
   }
 

@@ -9,7 +9,9 @@
 //   or a FIFO is written in place (collide/output_file.hpp), after the
 //   temporaries and before their rename.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
-//   project reports as throughput; reading, scheduling and writing are timed
+//   project reports as throughput, less the ISA measurement that the first
+//   solve of a process runs with --isa auto (isa_calibration_seconds,
+//   reported apart by solve_record); reading, scheduling and writing are timed
 //   separately, and io_seconds (read + write) with io_fraction (its share of
 //   read + schedule + kernel + write) say how much of a run is file I/O: for
 //   large scenes nearly all of it (2M bodies: seconds of CSV against
@@ -72,8 +74,9 @@ const char* const kSolveUsage =
     "                        the contacts reach bodies at random), soa or packed;\n"
     "                        results do not depend on it\n"
     "  --isa I               instruction set of the simd path: auto (default: $COLLIDE_ISA,\n"
-    "                        else the best this CPU has), sse2, avx2 or avx512;\n"
-    "                        results do not depend on it\n"
+    "                        else the fastest on this CPU, measured at the first solve\n"
+    "                        of each kind), sse2, avx2 or avx512; results do not\n"
+    "                        depend on it; --stats says which ran and how it was chosen\n"
     "  --accuracy A          fast (default: plain arithmetic, within a few eps of the\n"
     "                        impulse scale) or accurate (J within a few ulps of the\n"
     "                        exact law, slower); both are deterministic\n"
@@ -82,7 +85,8 @@ const char* const kSolveUsage =
     "                        error when the scene does not fit); results are the law's\n"
     "  --stats               print one JSON object of statistics on stderr (kernel,\n"
     "                        schedule, read and write times; io_fraction is the\n"
-    "                        share of file I/O, nearly all of a large scene's time)\n"
+    "                        share of file I/O, nearly all of a large scene's time;\n"
+    "                        isa and isa_choice: forced, environment or measured)\n"
     "  --check               also run the long double reference and compare the\n"
     "                        impulses; exit 3 if an error exceeds the documented bound\n"
     "\n"
@@ -100,7 +104,7 @@ struct SolveRequest {
   bool want_float = false;
   int threads = 0;
   Path path = Path::simd;
-  Isa isa = Isa::automatic;  // resolved in run_solve: never automatic when solving
+  Isa isa = Isa::automatic;  // checked in run_solve; automatic: COLLIDE_ISA, else measured by the Solver
   BodyLayout layout = BodyLayout::automatic;
   Accuracy accuracy = Accuracy::fast;
   bool auto_model = true;
@@ -266,11 +270,13 @@ int run_solve(int argc, char** argv) {
     req.path = it->second == "simd" ? Path::simd : Path::scalar;
   }
   {
-    // Resolved before anything is read: an unknown name, or an ISA this CPU
-    // lacks (named by --isa or by COLLIDE_ISA), is a usage error.
+    // Checked before anything is read: an unknown name, or an ISA this CPU
+    // lacks (named by --isa or by COLLIDE_ISA), is a usage error. automatic
+    // stays automatic: the Solver reads COLLIDE_ISA, or measures.
     const auto it = opt.find("isa");
     try {
-      req.isa = resolve_isa(it == opt.end() ? Isa::automatic : parse_isa(it->second));
+      req.isa = it == opt.end() ? Isa::automatic : parse_isa(it->second);
+      (void)resolve_isa(req.isa);
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string(it == opt.end() ? "" : "--isa: ") + e.what());
     }

@@ -26,6 +26,18 @@ const char* to_string(Isa isa) {
   return "?";
 }
 
+const char* to_string(IsaChoice choice) {
+  switch (choice) {
+    case IsaChoice::forced:
+      return "forced";
+    case IsaChoice::environment:
+      return "environment";
+    case IsaChoice::measured:
+      return "measured";
+  }
+  return "?";
+}
+
 Isa parse_isa(std::string_view name) {
   for (const Isa isa : {Isa::automatic, Isa::sse2, Isa::avx2, Isa::avx512}) {
     if (name == to_string(isa)) return isa;

@@ -8,19 +8,24 @@
 //   twice, so blocks of a batch run on any thread and contacts in any lane.
 //   The result of a contact depends only on its own two bodies, so the thread
 //   count and the block size cannot change a single bit.
-// * The ISA is resolved once, when the Solver is built (SolverOptions::isa,
-//   COLLIDE_ISA, CPUID), to a table of function pointers; a solve then costs
-//   one indirect call per block.
+// * A forced ISA (SolverOptions::isa, or COLLIDE_ISA) is resolved once,
+//   when the Solver is built, to a table of function pointers; a solve then
+//   costs one indirect call per block. Isa::automatic with COLLIDE_ISA unset
+//   picks the table per solve: the fastest ISA for the solve's model,
+//   precision, accuracy and scene kind (isa_calibration.hpp), a cached
+//   lookup after the first solve of that kind in the process.
 // * Nothing here allocates: the Solver owns its task_arena (or borrows the
 //   caller's, collide/tbb.hpp), the Schedule owns the order.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 
 #include <oneapi/tbb/blocked_range.h>
@@ -30,14 +35,49 @@
 
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
+#include "isa_calibration.hpp"
 #include "kernel_table.hpp"
 #include "scratch_records.hpp"
 
 namespace collide {
 
+namespace detail {
+namespace {
+
+/// How a Solver with `requested` picks its ISA: forced (a named ISA),
+/// environment (automatic and COLLIDE_ISA names one; "auto" there is the same
+/// as unset) or measured per solve.
+IsaChoice isa_choice_for(Isa requested) {
+  if (requested != Isa::automatic) return IsaChoice::forced;
+  const char* env = std::getenv("COLLIDE_ISA");
+  if (env == nullptr || *env == '\0' || std::string_view(env) == to_string(Isa::automatic)) {
+    return IsaChoice::measured;
+  }
+  return IsaChoice::environment;
+}
+
+/// The table of a fixed choice (resolve_isa checks the CPU and reads
+/// COLLIDE_ISA, throwing for an unknown or unsupported ISA); none when the
+/// choice is measured per solve.
+const KernelTable* fixed_kernels(Isa requested, IsaChoice choice) {
+  return choice == IsaChoice::measured ? nullptr : &kernel_table(resolve_isa(requested));
+}
+
+}  // namespace
+
+/// The kernels of one solve and how they were chosen.
+struct IsaPick {
+  const KernelTable* kernels;
+  IsaChoice choice;
+  double calibration_seconds;  // spent measuring by this solve (SolveStats::isa_calibration_seconds)
+};
+
+}  // namespace detail
+
 struct Solver::Impl {
   SolverOptions options;
-  const detail::KernelTable* kernels;    // of options.isa, resolved
+  IsaChoice isa_choice;                  // how the SIMD path's ISA is chosen
+  const detail::KernelTable* kernels;    // the fixed choice; nullptr when measured per solve
   std::optional<tbb::task_arena> owned;  // empty when the caller's arena is borrowed
   tbb::task_arena* arena;
   // Where SoA input is packed (BodyLayout): one buffer per record type, grown
@@ -81,11 +121,28 @@ struct Solver::Impl {
       // task_arena::automatic (which libtbb does not define) is not bound to
       // the in_place constructor's reference: unoptimised builds failed to link.
       : options(o),
-        kernels(&detail::kernel_table(resolve_isa(o.isa))),
+        isa_choice(detail::isa_choice_for(o.isa)),
+        kernels(detail::fixed_kernels(o.isa, isa_choice)),
         owned(std::in_place, o.threads > 0 ? o.threads : int{tbb::task_arena::automatic}),
         arena(&*owned) {}
   Impl(const SolverOptions& o, tbb::task_arena& borrowed)
-      : options(o), kernels(&detail::kernel_table(resolve_isa(o.isa))), arena(&borrowed) {}
+      : options(o),
+        isa_choice(detail::isa_choice_for(o.isa)),
+        kernels(detail::fixed_kernels(o.isa, isa_choice)),
+        arena(&borrowed) {}
+
+  /// The ISA of a solve of `model` in T: the fixed one, or the fastest for
+  /// the solve's kind (measured on first use). The scalar path runs the
+  /// baseline's one-lane kernel whatever the choice, and measures nothing.
+  /// `scattered` is the schedule's scattered contacts (scattered_contacts).
+  template <class T>
+  detail::IsaPick pick(Model model, std::size_t scattered, std::size_t contacts) const {
+    if (options.path == Path::scalar) return {&detail::kernel_table(Isa::sse2), IsaChoice::forced, 0.0};
+    if (kernels != nullptr) return {kernels, isa_choice, 0.0};
+    double spent = 0;
+    const Isa isa = detail::measured_isa<T>(model, options.accuracy, 2 * scattered > contacts, &spent).fastest;
+    return {&detail::kernel_table(isa), IsaChoice::measured, spent};
+  }
 };
 
 Solver::Solver(const SolverOptions& options) {
@@ -147,8 +204,9 @@ std::size_t simd_lanes(const KernelTable& table) {
 
 /// Walks the batches of the schedule; blocks of a large batch run in parallel.
 template <class T>
-SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb::task_arena& arena,
-                        const KernelJob<T>& job, std::size_t body_count, const Schedule& schedule) {
+SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task_arena& arena, const KernelJob<T>& job,
+                        std::size_t body_count, const Schedule& schedule) {
+  const KernelTable& table = *pick.kernels;
   assert(schedule.contact_count() == job.contacts.count);
   assert(schedule.body_count() == body_count);
   assert(job.impulses.count == job.contacts.count);
@@ -193,6 +251,8 @@ SolveStats run_schedule(const SolverOptions& opt, const KernelTable& table, tbb:
   stats.friction = job.friction;
   // The scalar path is the baseline object's one-lane kernel, on every ISA.
   stats.isa = simd ? table.isa : Isa::sse2;
+  stats.isa_choice = pick.choice;
+  stats.isa_calibration_seconds = pick.calibration_seconds;
   stats.layout = job.packed ? BodyLayout::packed : BodyLayout::soa;
   stats.accuracy = opt.accuracy;
   return stats;
@@ -234,7 +294,7 @@ std::size_t scattered_contacts(const Schedule& schedule) {
 /// bodies the two cost about the same; below that, or in scenes that stream
 /// (pairs), the SoA arrays are used in place.
 
-bool should_pack(BodyLayout layout, const Schedule& schedule, std::size_t bodies) {
+bool should_pack(BodyLayout layout, std::size_t scattered, std::size_t bodies) {
   switch (layout) {
     case BodyLayout::soa:
       return false;
@@ -243,7 +303,6 @@ bool should_pack(BodyLayout layout, const Schedule& schedule, std::size_t bodies
     case BodyLayout::automatic:
       break;
   }
-  const std::size_t scattered = scattered_contacts(schedule);
   return scattered >= 1024 && 4 * scattered >= bodies;
 }
 
@@ -268,7 +327,9 @@ template <class Record, class View, class T>
 SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<T>& contacts,
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
-  if (!detail::should_pack(impl_->options.layout, schedule, bodies.count)) {
+  const std::size_t scattered = detail::scattered_contacts(schedule);
+  const detail::IsaPick pick = impl_->pick<T>(model, scattered, schedule.contact_count());
+  if (!detail::should_pack(impl_->options.layout, scattered, bodies.count)) {
     if constexpr (std::is_same_v<View, BodyView<T>>) {
       job.rigid = bodies;
     } else if constexpr (std::is_same_v<View, SphereView<T>>) {
@@ -276,7 +337,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
     } else {
       job.particle = bodies;
     }
-    return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
+    return detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
   }
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
   PackedView<Record> packed;
@@ -288,7 +349,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   impl_->arena->execute([&] { pack(bodies, packed); });
   job.packed = true;
   detail::set_packed(job, packed);
-  SolveStats stats = detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
+  SolveStats stats = detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
   return stats;
 }
@@ -299,9 +360,10 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
+  const detail::IsaPick pick = impl_->pick<T>(model, detail::scattered_contacts(schedule), schedule.contact_count());
   // The caller's records are solved in place: no buffer of the solver's is
   // used, so solves on one Solver may run at once, as on SoA views.
-  return detail::run_schedule(impl_->options, *impl_->kernels, *impl_->arena, job, bodies.count, schedule);
+  return detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
 }
 
 template <class T>
@@ -355,7 +417,9 @@ SolveStats Solver::solve(Model model, const BodyView<T>& bodies, const ContactVi
   return solve(bodies, contacts, impulses, schedule);
 }
 
-Isa Solver::isa() const { return impl_->kernels->isa; }
+Isa Solver::isa() const { return impl_->kernels != nullptr ? impl_->kernels->isa : Isa::automatic; }
+
+IsaChoice Solver::isa_choice() const { return impl_->isa_choice; }
 
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,

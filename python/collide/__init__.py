@@ -72,10 +72,12 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     ``bodies.v`` and ``bodies.w`` are updated; J (shape (3, M), the dtype of
     the scene) is the impulse on body a of each contact. ``stats`` has the keys
     of ``collide solve --stats`` (collisions, impacts, bodies, kernel_seconds,
-    collisions_per_second, precision, threads, model, path, isa, accuracy,
-    lanes, batches, largest_batch, schedule_seconds). ``model`` is "auto" (the
+    collisions_per_second, precision, threads, model, path, isa, isa_choice,
+    layout, accuracy, lanes, batches, largest_batch, schedule_seconds,
+    isa_calibration_seconds). ``model`` is "auto" (the
     cheapest that fits), "rigid", "sphere" or "particle"; ``path`` "simd" or
-    "scalar"; ``threads`` 0 for all; ``isa`` None (automatic), "sse2", "avx2"
+    "scalar"; ``threads`` 0 for all; ``isa`` None (automatic: COLLIDE_ISA,
+    else the fastest on this CPU, measured once per process), "sse2", "avx2"
     or "avx512"; ``accuracy`` "fast" or "accurate". For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
     solving. Bad input raises TypeError or ValueError and modifies nothing.
@@ -199,13 +201,15 @@ def isa_supported(isa):
 
 
 def best_isa():
-    """The widest instruction set this CPU and build support (what "auto" is
-    when COLLIDE_ISA is not set)."""
+    """The widest instruction set this CPU and build support. Not always the
+    fastest: with COLLIDE_ISA unset a solver measures which is (stats["isa"]
+    says what ran)."""
     return _collide.best_isa()
 
 
 def simd_width(isa="auto", dtype=_np.float32):
-    """Lanes of the SIMD path for ``isa`` (resolved as the solver does) and dtype."""
+    """Lanes of the SIMD path for ``isa`` and dtype ("auto": COLLIDE_ISA, else
+    the widest ISA; a measured solve may run fewer, stats["lanes"] says)."""
     return _collide.simd_width(isa, dtype)
 
 

@@ -36,9 +36,11 @@ def test_bitwise_equal_to_cli(cli, workdir, dtype, precision, scene):
     # The stats dict has every key of --stats that is not about files.
     for key in set(cli_stats) - {"read_seconds", "write_seconds", "io_seconds", "io_fraction"}:
         assert key in stats, key
-    for key in ("collisions", "impacts", "bodies", "precision", "model", "path", "lanes", "batches", "largest_batch",
-                "isa", "accuracy"):
+    for key in ("collisions", "impacts", "bodies", "precision", "model", "path", "batches", "largest_batch",
+                "isa_choice", "accuracy"):
         assert stats[key] == cli_stats[key], key
+    # Each process measures its own pick: an ISA this CPU has, the same bits.
+    assert collide.isa_supported(stats["isa"]) and collide.isa_supported(cli_stats["isa"])
 
 
 def test_zero_copy_and_in_place():
@@ -105,7 +107,8 @@ def test_isa_and_accuracy_pass_through():
     assert stats["accuracy"] == "fast"
     assert stats["isa"] == "sse2"  # what ran (SolveStats::isa)
     _, stats = collide.solve(bodies, contacts)
-    assert stats["isa"] == collide.Solver().isa and collide.isa_supported(stats["isa"])
+    assert collide.Solver().isa == "auto" and stats["isa_choice"] == "measured"  # chosen per solve
+    assert stats["isa"] != "auto" and collide.isa_supported(stats["isa"])
     with pytest.raises(ValueError, match="accuracy"):
         collide.solve(bodies, contacts, accuracy="sloppy")
     with pytest.raises(ValueError, match="instruction set"):

@@ -144,6 +144,28 @@ TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {
   EXPECT_EQ(m.at("triad_array_bytes").num, static_cast<double>(collide::default_triad_array_bytes()));
 }
 
+// The machine block shows what Isa::automatic picks: every precision,
+// accuracy, model and scene kind, each an ISA this CPU has, in the JSON and
+// in the table.
+TEST_F(ReportRun, MachineShowsTheIsaAutoPicks) {
+  ASSERT_TRUE(report_->json.has("machine")) << report_->result.err;
+  const Json& m = report_->json.at("machine");
+  ASSERT_TRUE(m.has("isa_auto"));
+  const Json& picks = m.at("isa_auto");
+  ASSERT_EQ(picks.kind, Json::array);
+  std::set<std::string> keys;
+  for (const Json& p : picks.items) {
+    keys.insert(p.at("precision").str + " " + p.at("accuracy").str + " " + p.at("model").str + " " + p.at("scene").str);
+    const std::string& isa = p.at("isa").str;
+    EXPECT_TRUE(collide::isa_supported(collide::parse_isa(isa)) && isa != "auto") << isa;
+    EXPECT_EQ(p.at("ns_per_contact").fields.count(isa), p.at("ns_per_contact").fields.empty() ? 0U : 1U) << isa;
+    EXPECT_GE(p.at("calibration_seconds").num, 0.0);
+  }
+  EXPECT_EQ(keys.size(), 24U);
+  EXPECT_EQ(picks.items.size(), 24U);
+  EXPECT_NE(report_->result.out.find("isa auto ("), std::string::npos) << report_->result.out;
+}
+
 TEST_F(ReportRun, JsonHoldsEveryVariant) {
   ASSERT_TRUE(report_->json.has("rows")) << report_->result.err;
   std::set<Key> seen;

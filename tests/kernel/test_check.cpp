@@ -94,11 +94,24 @@ TEST(Check, ImpactsAndRecord) {
   StatRecord r = solve_record<double>(st, std::as_const(j).view(), 8, 0.0, 0.5);
   std::vector<std::string> keys;
   for (const auto& kv : r) keys.push_back(kv.first);
-  const std::vector<std::string> expected = {
-      "collisions",      "impacts",  "bodies", "kernel_seconds", "collisions_per_second",
-      "precision",       "threads",  "model",  "path",           "isa",
-      "layout",          "accuracy", "lanes",  "batches",        "largest_batch",
-      "schedule_seconds"};
+  const std::vector<std::string> expected = {"collisions",
+                                             "impacts",
+                                             "bodies",
+                                             "kernel_seconds",
+                                             "collisions_per_second",
+                                             "precision",
+                                             "threads",
+                                             "model",
+                                             "path",
+                                             "isa",
+                                             "isa_choice",
+                                             "layout",
+                                             "accuracy",
+                                             "lanes",
+                                             "batches",
+                                             "largest_batch",
+                                             "schedule_seconds",
+                                             "isa_calibration_seconds"};
   EXPECT_EQ(keys, expected);
   add_check(r, ImpulseCheck{}, 0.25);
   const std::string json = to_json(r);
@@ -106,7 +119,22 @@ TEST(Check, ImpactsAndRecord) {
   EXPECT_NE(json.find("\"collisions_per_second\": null"), std::string::npos) << json;  // 0 s: inf
   EXPECT_NE(json.find("\"precision\": \"double\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"isa\": \"avx2\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"isa_choice\": \"forced\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"check_passed\": true"), std::string::npos) << json;
+
+  // A solve that measured the ISAs reports that time apart from the kernel's.
+  st.isa_choice = IsaChoice::measured;
+  st.isa_calibration_seconds = 0.25;
+  const StatRecord m = solve_record<double>(st, std::as_const(j).view(), 8, 1.0, 0.5);
+  const auto value = [&](const char* key) {
+    for (const auto& [k, v] : m) {
+      if (k == key) return v;
+    }
+    return StatValue{};
+  };
+  EXPECT_EQ(std::get<double>(value("kernel_seconds")), 0.75);
+  EXPECT_EQ(std::get<double>(value("isa_calibration_seconds")), 0.25);
+  EXPECT_EQ(std::get<std::string>(value("isa_choice")), "measured");
 }
 
 TEST(ValidateIndices, NamesTheFirstBadIndex) {

@@ -16,6 +16,7 @@
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
+#include "support/isa_env.hpp"
 #include "support/scenes.hpp"
 #include "support/solve_helpers.hpp"
 
@@ -23,32 +24,6 @@ namespace collide::test {
 namespace {
 
 const Isa kConcrete[] = {Isa::sse2, Isa::avx2, Isa::avx512};
-
-/// Sets or clears COLLIDE_ISA for one scope.
-class IsaEnv {
- public:
-  explicit IsaEnv(const char* value) {
-    if (const char* old = std::getenv("COLLIDE_ISA")) saved_ = old, had_ = true;
-    if (value) {
-      setenv("COLLIDE_ISA", value, 1);
-    } else {
-      unsetenv("COLLIDE_ISA");
-    }
-  }
-  ~IsaEnv() {
-    if (had_) {
-      setenv("COLLIDE_ISA", saved_.c_str(), 1);
-    } else {
-      unsetenv("COLLIDE_ISA");
-    }
-  }
-  IsaEnv(const IsaEnv&) = delete;
-  IsaEnv& operator=(const IsaEnv&) = delete;
-
- private:
-  std::string saved_;
-  bool had_ = false;
-};
 
 TEST(Isa, NamesRoundTrip) {
   for (const Isa isa : {Isa::automatic, Isa::sse2, Isa::avx2, Isa::avx512}) {
@@ -89,20 +64,25 @@ TEST(Isa, EnvironmentChoosesTheDefault) {
   {
     const IsaEnv env(nullptr);
     EXPECT_EQ(default_isa(), best_isa());
-    EXPECT_EQ(Solver().isa(), best_isa());
+    // Unset: a default Solver measures per solve (test_isa_auto.cpp).
+    EXPECT_EQ(Solver().isa(), Isa::automatic);
+    EXPECT_EQ(Solver().isa_choice(), IsaChoice::measured);
   }
   {
     const IsaEnv env("sse2");
     EXPECT_EQ(default_isa(), Isa::sse2);
     EXPECT_EQ(Solver().isa(), Isa::sse2);
+    EXPECT_EQ(Solver().isa_choice(), IsaChoice::environment);
     // An explicit option wins over the environment.
     SolverOptions o;
     o.isa = best_isa();
     EXPECT_EQ(Solver(o).isa(), best_isa());
+    EXPECT_EQ(Solver(o).isa_choice(), IsaChoice::forced);
   }
   {
     const IsaEnv env("auto");
     EXPECT_EQ(default_isa(), best_isa());
+    EXPECT_EQ(Solver().isa_choice(), IsaChoice::measured);
   }
   {
     const IsaEnv env("avx3");

@@ -68,8 +68,11 @@ using StatValue = std::variant<std::uint64_t, double, std::string, bool>;
 using StatRecord = std::vector<std::pair<std::string, StatValue>>;
 
 /// The record of one solve: collisions, impacts, bodies, kernel_seconds,
-/// collisions_per_second, precision, threads, model, path, isa, accuracy,
-/// lanes, batches, largest_batch, schedule_seconds.
+/// collisions_per_second, precision, threads, model, path, isa, isa_choice,
+/// layout, accuracy, lanes, batches, largest_batch, schedule_seconds,
+/// isa_calibration_seconds. `kernel_seconds` is the wall time of the solve
+/// call; the ISA measurement it may contain (SolveStats::
+/// isa_calibration_seconds) is taken out of it and reported on its own.
 template <class T>
 StatRecord solve_record(const SolveStats& stats, const ImpulseView<const T>& impulses, std::size_t bodies,
                         double kernel_seconds, double schedule_seconds);

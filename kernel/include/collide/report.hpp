@@ -101,6 +101,19 @@ struct SweepPoint {
   double bandwidth_fraction = 0;
 };
 
+/// What Isa::automatic picks on this machine for one kind of solve
+/// (collide::fastest_isa, measured in the report's own process).
+struct IsaAutoPick {
+  std::string precision;           ///< "float" or "double"
+  std::string model;               ///< "particle", "sphere" or "rigid"
+  std::string accuracy;            ///< "fast" or "accurate"
+  bool scattered = false;          ///< a scattered scene (debris-like), else streaming (pairs-like)
+  std::string isa;                 ///< the pick
+  double calibration_seconds = 0;  ///< time the measurement took
+  /// Best pass of each ISA measured, in ns per contact, named ("sse2": 21.5).
+  std::vector<std::pair<std::string, double>> ns_per_contact;
+};
+
 /// Facts about the machine the numbers came from.
 struct MachineInfo {
   std::string cpu;
@@ -110,7 +123,8 @@ struct MachineInfo {
   std::vector<double> triad_bytes_per_second;                ///< best pass (the bound), same order
   std::vector<double> triad_median_bytes_per_second;         ///< median pass, same order
   std::size_t triad_array_bytes = 0;
-  std::string simd_build;  ///< e.g. "avx512 (of sse2, avx2, avx512): 16 float / 8 double lanes"
+  std::string simd_build;             ///< e.g. "avx512 (of sse2, avx2, avx512): 16 float / 8 double lanes"
+  std::vector<IsaAutoPick> isa_auto;  ///< every precision x accuracy x model x scene kind
   double load_average = -1;
 };
 

@@ -62,9 +62,12 @@ struct SolverOptions {
   /// and lets the small batches of shared-body scenes (the debris scene's
   /// batches are a few thousand contacts at 64k) still split across threads.
   std::size_t block = 1024;
-  /// Instruction set of the SIMD path (collide/isa.hpp): automatic is
-  /// COLLIDE_ISA, else the best the CPU has. Resolved when the Solver is
-  /// built; one the CPU lacks makes the constructor throw.
+  /// Instruction set of the SIMD path (collide/isa.hpp). A named one, or the
+  /// one COLLIDE_ISA names when this is automatic, is resolved when the
+  /// Solver is built (one the CPU lacks makes the constructor throw) and runs
+  /// every solve. automatic with COLLIDE_ISA unset picks per solve the ISA
+  /// that ran fastest on this CPU for the solve's model, precision, accuracy
+  /// and scene kind (fastest_isa()). Results never depend on it.
   Isa isa = Isa::automatic;
   Accuracy accuracy = Accuracy::fast;
   /// For SoA input: automatic packs it when that is faster (Solver::solve),
@@ -82,15 +85,57 @@ struct SolveStats {
   int threads = 0;                ///< threads available to the solve
   Model model = Model::rigid;
   Path path = Path::simd;
-  bool friction = false;                ///< the Coulomb step ran (ContactView::mu was set)
-  Isa isa = Isa::sse2;                  ///< the instruction set that ran (never automatic)
+  bool friction = false;                     ///< the Coulomb step ran (ContactView::mu was set)
+  Isa isa = Isa::sse2;                       ///< the instruction set that ran (never automatic)
+  IsaChoice isa_choice = IsaChoice::forced;  ///< how `isa` was chosen (collide/isa.hpp)
+  /// Time this solve spent measuring the ISAs for fastest_isa() [s]: the
+  /// first solve of its kind in the process with isa_choice measured pays
+  /// about a millisecond, every later one 0. Part of the solve's wall time.
+  double isa_calibration_seconds = 0;
   BodyLayout layout = BodyLayout::soa;  ///< the layout the kernel ran on (never automatic)
   Accuracy accuracy = Accuracy::fast;
 };
 
-/// Number of lanes of the SIMD path for T under default_isa().
+/// Number of lanes of the SIMD path for T under default_isa() (COLLIDE_ISA,
+/// else the widest ISA). A solve whose ISA was measured (SolveStats::
+/// isa_choice) may run fewer: SolveStats::lanes says what it ran.
 template <class T>
 std::size_t simd_width();
+
+/// The ISA whose SIMD kernel ran fastest on this CPU for `model` in precision
+/// T (float or double) and `accuracy`, on a streaming scene (scattered =
+/// false: contact k joins bodies 2k and 2k+1, the SoA arrays in order) or a
+/// scattered one (scattered = true: contacts reach packed bodies at random,
+/// as in the debris scene). It is what a Solver with Isa::automatic and
+/// COLLIDE_ISA unset runs; a solve counts as scattered when most of its
+/// schedule's contacts are in non-contiguous batches.
+///
+/// Measured once per process at the first call for each key (thread-safe;
+/// later calls return the cached answer): every ISA the CPU has runs its
+/// kernel on one thread over a small synthetic scene in cache, round by
+/// round, and the fastest best time wins. That takes a millisecond or two
+/// (isa_measurement() says how long). With one ISA, nothing is measured.
+/// COLLIDE_ISA does not affect it.
+template <class T>
+Isa fastest_isa(Model model, Accuracy accuracy, bool scattered);
+
+/// What the measurement behind fastest_isa() found for one key.
+struct IsaMeasurement {
+  Isa fastest = Isa::sse2;  ///< fastest_isa() for the key
+  /// Contacts of each timed pass over the synthetic scene: up to 1024, fewer
+  /// for slow kernels (0: nothing was measured).
+  std::size_t contacts = 0;
+  int rounds = 0;                  ///< timed passes per ISA (after one warm-up pass)
+  double calibration_seconds = 0;  ///< wall time of the whole measurement [s]
+  /// The best time of one timed pass for sse2, avx2 and avx512 in that order
+  /// [s]; 0 for an ISA not measured (the CPU lacks it).
+  double seconds[3] = {0, 0, 0};
+};
+
+/// The measurement of fastest_isa(model, accuracy, scattered), run first if
+/// it has not run in this process yet.
+template <class T>
+IsaMeasurement isa_measurement(Model model, Accuracy accuracy, bool scattered);
 
 /// A caller's tbb::task_arena, defined in collide/tbb.hpp so that this header
 /// does not need TBB.
@@ -106,8 +151,9 @@ struct ExternalArena;
 /// into the solver's own buffer, solved there, and v, w written back: the
 /// same bits as solving in place, several times faster on scattered scenes
 /// (README, "Performance"). The buffer grows to the largest scene seen and is
-/// kept; solves that pack on one Solver run one at a time. There is no global state: two
-/// solvers never share threads unless their caller shares an arena.
+/// kept; solves that pack on one Solver run one at a time. The only state
+/// shared between solvers is the process's cache of fastest_isa() answers:
+/// two solvers never share threads unless their caller shares an arena.
 class Solver {
  public:
   explicit Solver(const SolverOptions& options = {});
@@ -122,9 +168,15 @@ class Solver {
   Solver& operator=(Solver&&) noexcept;
 
   [[nodiscard]] const SolverOptions& options() const;
-  /// The instruction set this solver's SIMD path runs (options().isa
-  /// resolved; never automatic).
+  /// The instruction set this solver's SIMD path runs when it is fixed:
+  /// options().isa, or the one COLLIDE_ISA named when that was automatic.
+  /// Isa::automatic when the choice is made per solve (isa_choice() is
+  /// measured): each solve's SolveStats::isa says which ISA ran.
   [[nodiscard]] Isa isa() const;
+  /// How the ISA of this solver's SIMD solves is chosen: forced,
+  /// environment or measured (SolveStats::isa_choice, which is forced on the
+  /// scalar path: it always runs the baseline).
+  [[nodiscard]] IsaChoice isa_choice() const;
 
   /// Resolves every contact: updates v and w of movable bodies and writes J.
   /// Preconditions (checked by validate(), asserted in debug builds): the

@@ -157,6 +157,33 @@ std::string format_report_table(const Report& report) {
   std::snprintf(line, sizeof line, "\n  (best pass is the bound; 3 float arrays of %s); load average %.2f at start\n",
                 mib(m.triad_array_bytes).c_str(), m.load_average);
   out += line;
+  if (!m.isa_auto.empty()) {
+    // Four lines: one per precision and accuracy, "streaming/scattered" per model.
+    double seconds = 0;
+    for (const IsaAutoPick& p : m.isa_auto) seconds += p.calibration_seconds;
+    std::snprintf(line, sizeof line,
+                  "isa auto (the fastest ISA per kind of solve, measured once per process: %.1f ms for %zu kinds), "
+                  "streaming/scattered:\n",
+                  1e3 * seconds, m.isa_auto.size());
+    out += line;
+    std::string last;
+    for (const IsaAutoPick& p : m.isa_auto) {
+      const std::string group = p.precision + " " + p.accuracy;
+      if (group != last) {
+        if (!last.empty()) out += "\n";
+        std::snprintf(line, sizeof line, "  %-6s %-8s ", p.precision.c_str(), p.accuracy.c_str());
+        out += line;
+        last = group;
+      }
+      if (!p.scattered) {
+        std::snprintf(line, sizeof line, " %s %s", p.model.c_str(), p.isa.c_str());
+      } else {
+        std::snprintf(line, sizeof line, "/%s", p.isa.c_str());
+      }
+      out += line;
+    }
+    out += "\n";
+  }
   out += "peer: " + report.peer_status + "\n";
   std::snprintf(line, sizeof line,
                 "speed: median of timed runs of the solve alone; bw = share of the bandwidth bound.\n"
@@ -264,7 +291,19 @@ std::string format_report_json(const Report& report) {
     s += (i ? ", " : "") + json_string(std::to_string(m.triad_threads[i])) + ": " +
          json_number(m.triad_median_bytes_per_second[i]);
   }
-  s += "}},\n  \"rows\": [\n";
+  s += "}, \"isa_auto\": [";
+  for (std::size_t i = 0; i < m.isa_auto.size(); ++i) {
+    const IsaAutoPick& p = m.isa_auto[i];
+    s += std::string(i ? ",\n" : "\n") + "    {\"precision\": " + json_string(p.precision) +
+         ", \"model\": " + json_string(p.model) + ", \"accuracy\": " + json_string(p.accuracy) +
+         ", \"scene\": " + json_string(p.scattered ? "scattered" : "streaming") + ", \"isa\": " + json_string(p.isa) +
+         ", \"calibration_seconds\": " + json_number(p.calibration_seconds) + ", \"ns_per_contact\": {";
+    for (std::size_t k = 0; k < p.ns_per_contact.size(); ++k) {
+      s += (k ? ", " : "") + json_string(p.ns_per_contact[k].first) + ": " + json_number(p.ns_per_contact[k].second);
+    }
+    s += "}}";
+  }
+  s += "]},\n  \"rows\": [\n";
   for (std::size_t i = 0; i < report.rows.size(); ++i) {
     const ReportRow& r = report.rows[i];
     s += "    {\"scene\": " + json_string(r.scene) + ", \"variant\": " + json_string(r.variant) +
