@@ -301,7 +301,7 @@ std::string solve_name(Kind kind, const char* precision, Path path, int threads,
   return std::string("solve/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(path) +
          "/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
-/// The SIMD path of one instruction set (issue 12: every ISA the CPU has), or
+/// The SIMD path of one instruction set (every ISA the CPU has), or
 /// of Isa::automatic ("auto").
 std::string isa_name(Kind kind, const char* precision, collide::Isa isa, int threads, std::size_t n) {
   return std::string("isa/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(isa) +
