@@ -1,10 +1,14 @@
 // collide/validate.hpp - checking views before they reach a kernel.
 //
-// The kernels trust their input: in release builds they check nothing, in
-// debug builds they assert the cheap preconditions (index range, a != b, view
-// sizes). A caller that hands over its own arrays calls validate() at the
-// boundary, once per scene or whenever the data may be bad; the CLI's file
-// reader applies the stricter scene-file rules of docs/collision-law.md.
+// The kernels trust the values of their input; what keeps them inside the
+// arrays is checked in every build type: Schedule::build checks every index
+// (< bodies.count, a != b), and Solver::solve the counts (the schedule's
+// against the views', impulses against contacts) and that no array it reads
+// is null. The values (finite, unit vectors, e in [0, 1], ...) are the
+// caller's: a caller that hands over its own arrays calls validate() at the
+// boundary, once per scene or whenever the data may be bad, and the one-shot
+// collide::solve() calls it itself; the CLI's file reader applies the
+// stricter scene-file rules of docs/collision-law.md.
 #pragma once
 
 #include <string>
