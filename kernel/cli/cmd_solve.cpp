@@ -8,6 +8,12 @@
 //   pre-existing outputs untouched. An output that is stdout ("-"), a device
 //   or a FIFO is written in place (collide/output_file.hpp), after the
 //   temporaries and before their rename.
+// * The library checks what keeps a solve inside the arrays (Schedule::build
+//   every index, Solver::solve the counts) and throws std::invalid_argument
+//   otherwise. The reader's rules are stricter, so that cannot happen on a
+//   scene it accepted; if it did, the exception reaches main(), which prints
+//   "collide: <message>" and exits 1, and since no output is opened before
+//   the solve returns, nothing is written.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
 //   project reports as throughput, less the ISA measurement that the first
 //   solve of a process runs with --isa auto (isa_calibration_seconds,

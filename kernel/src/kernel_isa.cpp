@@ -224,12 +224,18 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
 inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
 
 /// Asks for the lines of contact k's fields and of its J: a scattered batch
-/// reads them from lines that hold few other contacts of the batch.
-template <class T>
+/// reads them from lines that hold few other contacts of the batch. The
+/// contact point only when the model reads it (kPoint): a particle solve may
+/// have none (contacts.c null), and offsetting a null pointer is undefined
+/// even where only a prefetch uses the result.
+template <bool kPoint, class T>
 COLLIDE_LANE_INLINE void prefetch_contact(const ContactView<T>& c, const ImpulseView<T>& j, std::uint32_t k) {
   __builtin_prefetch(c.a + k, 0, 2);
   __builtin_prefetch(c.b + k, 0, 2);
-  for (const T* f : {c.c.x, c.c.y, c.c.z, c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
+  if constexpr (kPoint) {
+    for (const T* f : {c.c.x, c.c.y, c.c.z}) __builtin_prefetch(f + k, 0, 2);
+  }
+  for (const T* f : {c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
   if (c.e != nullptr) __builtin_prefetch(c.e + k, 0, 2);
   if (c.mu != nullptr) __builtin_prefetch(c.mu + k, 0, 2);
   for (T* f : {j.j.x, j.j.y, j.j.z}) __builtin_prefetch(f + k, 1, 2);
@@ -245,7 +251,7 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
     if (W > 1) {
       if (!contiguous) {
         for (std::size_t k = begin; k < std::min(end, begin + 2 * kPrefetchAhead); ++k) {
-          prefetch_contact(contacts, impulses, order[k]);
+          prefetch_contact<kRotates<M>>(contacts, impulses, order[k]);
         }
       }
       for (std::size_t k = begin; k < std::min(end, begin + kPrefetchAhead); ++k) {
@@ -255,7 +261,7 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
       for (; i + W <= end; i += W) {
         if (!contiguous) {
           for (std::size_t k = i + 2 * kPrefetchAhead; k < std::min(end, i + W + 2 * kPrefetchAhead); ++k) {
-            prefetch_contact(contacts, impulses, order[k]);
+            prefetch_contact<kRotates<M>>(contacts, impulses, order[k]);
           }
         }
         for (std::size_t k = i + kPrefetchAhead; k < std::min(end, i + W + kPrefetchAhead); ++k) {

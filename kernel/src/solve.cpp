@@ -17,6 +17,7 @@
 // * Nothing here allocates: the Solver owns its task_arena (or borrows the
 //   caller's, collide/tbb.hpp), the Schedule owns the order.
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
@@ -27,6 +28,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -36,6 +38,7 @@
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
 #include "isa_calibration.hpp"
+#include "collide/validate.hpp"
 #include "kernel_table.hpp"
 #include "scratch_records.hpp"
 
@@ -203,15 +206,11 @@ std::size_t simd_lanes(const KernelTable& table) {
 }
 
 /// Walks the batches of the schedule; blocks of a large batch run in parallel.
+/// The counts and arrays were checked (check_solve_input).
 template <class T>
 SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task_arena& arena, const KernelJob<T>& job,
-                        std::size_t body_count, const Schedule& schedule) {
+                        const Schedule& schedule) {
   const KernelTable& table = *pick.kernels;
-  assert(schedule.contact_count() == job.contacts.count);
-  assert(schedule.body_count() == body_count);
-  assert(job.impulses.count == job.contacts.count);
-  (void)body_count;
-
   const bool simd = opt.path == Path::simd;
   const std::size_t width = simd ? simd_lanes<T>(table) : 1;
   const std::size_t block = std::max<std::size_t>(width, (opt.block + width - 1) / width * width);
@@ -319,6 +318,107 @@ void set_packed(KernelJob<T>& job, const PackedView<PackedParticle<T>>& v) {
   job.packed_particle = v;
 }
 
+/// The name of the first null array the kernels of a view read, or nullptr.
+template <class T, std::size_t N>
+const char* first_null(const std::array<std::pair<const char*, const T*>, N>& arrays) {
+  for (const auto& [name, p] : arrays) {
+    if (p == nullptr) return name;
+  }
+  return nullptr;
+}
+template <class T>
+const char* first_null(const BodyView<T>& b) {
+  return first_null<T, 17>({{{"inv_mass", b.inv_mass},
+                             {"inv_inertia.x", b.inv_inertia.x},
+                             {"inv_inertia.y", b.inv_inertia.y},
+                             {"inv_inertia.z", b.inv_inertia.z},
+                             {"q.w", b.q.w},
+                             {"q.x", b.q.x},
+                             {"q.y", b.q.y},
+                             {"q.z", b.q.z},
+                             {"p.x", b.p.x},
+                             {"p.y", b.p.y},
+                             {"p.z", b.p.z},
+                             {"v.x", b.v.x},
+                             {"v.y", b.v.y},
+                             {"v.z", b.v.z},
+                             {"w.x", b.w.x},
+                             {"w.y", b.w.y},
+                             {"w.z", b.w.z}}});
+}
+template <class T>
+const char* first_null(const SphereView<T>& b) {
+  return first_null<T, 11>({{{"inv_mass", b.inv_mass},
+                             {"inv_inertia", b.inv_inertia},
+                             {"p.x", b.p.x},
+                             {"p.y", b.p.y},
+                             {"p.z", b.p.z},
+                             {"v.x", b.v.x},
+                             {"v.y", b.v.y},
+                             {"v.z", b.v.z},
+                             {"w.x", b.w.x},
+                             {"w.y", b.w.y},
+                             {"w.z", b.w.z}}});
+}
+template <class T>
+const char* first_null(const ParticleView<T>& b) {
+  return first_null<T, 4>({{{"inv_mass", b.inv_mass}, {"v.x", b.v.x}, {"v.y", b.v.y}, {"v.z", b.v.z}}});
+}
+template <class T>
+const char* first_null(const PackedView<PackedRigid<T>>& b) {
+  if (b.bodies == nullptr) return "records";
+  return b.inv_mass == nullptr ? "inv_mass" : nullptr;
+}
+template <class Record>
+const char* first_null(const PackedView<Record>& b) {
+  return b.bodies == nullptr ? "records" : nullptr;
+}
+
+/// What keeps a solve inside the caller's arrays, checked in O(1) before
+/// anything is read or written: the schedule was built for as many contacts
+/// and bodies as the views hold (its build checked every index against that
+/// body count), J has a slot per contact, and no array the kernels of `model`
+/// read is null. Throws std::invalid_argument naming the counts or the array.
+/// The values are the caller's to vouch for (validate()).
+template <class T, class View>
+void check_solve_input(Model model, const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                       const Schedule& schedule) {
+  const char* const where = "collide::Solver::solve: ";  // a string only when it throws: a solve allocates nothing
+  if (schedule.contact_count() != contacts.count || schedule.body_count() != bodies.count) {
+    throw std::invalid_argument(
+        std::string(where) + "the schedule was built for " + std::to_string(schedule.contact_count()) +
+        " contacts and " + std::to_string(schedule.body_count()) + " bodies, not " + std::to_string(contacts.count) +
+        " contacts and " + std::to_string(bodies.count) + " bodies");
+  }
+  if (impulses.count != contacts.count) {
+    throw std::invalid_argument(std::string(where) + "impulses.count = " + std::to_string(impulses.count) +
+                                " but contacts.count = " + std::to_string(contacts.count));
+  }
+  if (bodies.count > 0) {
+    if (const char* name = first_null(bodies)) {
+      throw std::invalid_argument(std::string(where) + "bodies." + name +
+                                  " is null but bodies.count = " + std::to_string(bodies.count));
+    }
+  }
+  if (contacts.count > 0) {
+    const char* name = contacts.a == nullptr ? "a" : contacts.b == nullptr ? "b" : nullptr;
+    if (name == nullptr) {
+      name = first_null<const T, 3>({{{"n.x", contacts.n.x}, {"n.y", contacts.n.y}, {"n.z", contacts.n.z}}});
+    }
+    if (name == nullptr && model != Model::particle) {  // particles never read the contact point
+      name = first_null<const T, 3>({{{"c.x", contacts.c.x}, {"c.y", contacts.c.y}, {"c.z", contacts.c.z}}});
+    }
+    if (name != nullptr) {
+      throw std::invalid_argument(std::string(where) + "contacts." + name +
+                                  " is null but contacts.count = " + std::to_string(contacts.count));
+    }
+    if (const char* j = first_null<T, 3>({{{"j.x", impulses.j.x}, {"j.y", impulses.j.y}, {"j.z", impulses.j.z}}})) {
+      throw std::invalid_argument(std::string(where) + "impulses." + j +
+                                  " is null but impulses.count = " + std::to_string(impulses.count));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace detail
 
@@ -326,6 +426,7 @@ void set_packed(KernelJob<T>& job, const PackedView<PackedParticle<T>>& v) {
 template <class Record, class View, class T>
 SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<T>& contacts,
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
+  detail::check_solve_input(model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   const std::size_t scattered = detail::scattered_contacts(schedule);
   const detail::IsaPick pick = impl_->pick<T>(model, scattered, schedule.contact_count());
@@ -337,7 +438,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
     } else {
       job.particle = bodies;
     }
-    return detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
+    return detail::run_schedule(impl_->options, pick, *impl_->arena, job, schedule);
   }
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
   PackedView<Record> packed;
@@ -349,7 +450,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   impl_->arena->execute([&] { pack(bodies, packed); });
   job.packed = true;
   detail::set_packed(job, packed);
-  SolveStats stats = detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
+  SolveStats stats = detail::run_schedule(impl_->options, pick, *impl_->arena, job, schedule);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
   return stats;
 }
@@ -357,13 +458,14 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
 template <class Record, class T>
 SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                                 const ImpulseView<T>& impulses, const Schedule& schedule) const {
+  detail::check_solve_input(model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
   const detail::IsaPick pick = impl_->pick<T>(model, detail::scattered_contacts(schedule), schedule.contact_count());
   // The caller's records are solved in place: no buffer of the solver's is
   // used, so solves on one Solver may run at once, as on SoA views.
-  return detail::run_schedule(impl_->options, pick, *impl_->arena, job, bodies.count, schedule);
+  return detail::run_schedule(impl_->options, pick, *impl_->arena, job, schedule);
 }
 
 template <class T>
@@ -405,16 +507,22 @@ SolveStats Solver::solve(const PackedView<PackedParticle<T>>& bodies, const Cont
 template <class T>
 SolveStats Solver::solve(Model model, const BodyView<T>& bodies, const ContactView<T>& contacts,
                          const ImpulseView<T>& impulses, const Schedule& schedule) const {
-  assert(model_misfit(model, bodies, contacts).empty());
+  const auto run = [&](const auto& view) {
+    // The counts and arrays first: a call they refuse never reaches the
+    // debug builds' fit assertion, which reads the bodies of every contact.
+    detail::check_solve_input(model, view, contacts, impulses, schedule);
+    assert(model_misfit(model, bodies, contacts).empty());
+    return solve(view, contacts, impulses, schedule);
+  };
   switch (model) {
     case Model::particle:
-      return solve(particle_view(bodies), contacts, impulses, schedule);
+      return run(particle_view(bodies));
     case Model::sphere:
-      return solve(sphere_view(bodies), contacts, impulses, schedule);
+      return run(sphere_view(bodies));
     case Model::rigid:
       break;
   }
-  return solve(bodies, contacts, impulses, schedule);
+  return run(bodies);
 }
 
 Isa Solver::isa() const { return impl_->kernels != nullptr ? impl_->kernels->isa : Isa::automatic; }
@@ -424,6 +532,9 @@ IsaChoice Solver::isa_choice() const { return impl_->isa_choice; }
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                  const SolverOptions& options) {
+  if (const Validation v = validate(bodies, contacts, impulses); !v) {
+    throw std::invalid_argument("collide::solve: " + v.message);
+  }
   const Solver solver(options);  // validates the options before any work
   Schedule schedule;
   schedule.build(contacts, bodies, options.threads);  // on no more threads than the solve may use

@@ -12,8 +12,11 @@
 //   array and the first bad element) before anything is written, so bad input
 //   modifies nothing. Whether a scene fits a model is model_misfit()'s.
 // * check=False (Solver.solve) skips validate() and the model-fit check for
-//   frame loops that validated their scene once; validate_indices() still
-//   runs, so no index outside the arrays ever reaches the kernel.
+//   frame loops that validated their scene once; the indices are still
+//   checked, so no index outside the arrays ever reaches the kernel: by
+//   Schedule::build when the solve builds its schedule, by validate_indices()
+//   beside a schedule the caller built earlier. The library's
+//   std::invalid_argument (Schedule::build, Solver::solve) becomes ValueError.
 // * The GIL is released around every long C++ call (solve, reference,
 //   report, generate, file I/O). The ndarrays stay referenced by the Bodies
 //   and Contacts objects (and the call's arguments) meanwhile.
@@ -711,13 +714,17 @@ struct PySchedule {
   std::size_t contacts = 0, bodies = 0;
   double build_seconds = 0;
 
+  /// Schedule::build's std::invalid_argument (a bad index, named) becomes
+  /// ValueError.
   template <class T, class B>
   void build(const B& b, const Contacts& c) {
     const ContactView<T> cv = c.view<T>();
     const auto t0 = Clock::now();
-    {
+    try {
       py::gil_scoped_release release;
       build_schedule<T>(schedule, cv, b);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(e.what());
     }
     build_seconds = seconds_since(t0);
     contacts = c.count;
@@ -768,29 +775,37 @@ struct PySolver {
     T* jp = data<T>(j);
     const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
     const ContactView<T> cv = contacts.view<T>();
+    // Unchecked values are the caller's word; indices never are (memory
+    // safety). A schedule built here checks every index in its own pass
+    // (Schedule::build throws std::invalid_argument, a ValueError here); a
+    // schedule built earlier vouches only for the indices it saw then, so
+    // the indices are checked again beside it.
     if (check) {
       if (const Validation v = validate_values<T>(bodies, cv, jv); !v) throw py::value_error(v.message);
-    } else if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bodies.count); !v) {
-      // Unchecked values are the caller's word; indices never are (memory safety).
-      throw py::value_error(v.message);
+    } else if (schedule != nullptr) {
+      if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bodies.count); !v) {
+        throw py::value_error(v.message);
+      }
     }
-    const Model model = solve_model<T>(bodies, cv, requested, check);
     PySchedule own;
     if (schedule == nullptr) {
-      own.build<T>(bodies, contacts);
+      own.build<T>(bodies, contacts);  // before the model choice, which reads the bodies of every contact
       schedule = &own;
     } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
       throw py::value_error("schedule was built for " + std::to_string(schedule->contacts) + " contacts and " +
                             std::to_string(schedule->bodies) + " bodies, not " + std::to_string(contacts.count) +
                             " and " + std::to_string(bodies.count));
     }
+    const Model model = solve_model<T>(bodies, cv, requested, check);
     SolveStats stats;
     double kernel_seconds = 0;
-    {
+    try {
       py::gil_scoped_release release;
       const auto t0 = Clock::now();
       stats = run_solve<T>(*solver, model, bodies, cv, jv, schedule->schedule);
       kernel_seconds = seconds_since(t0);
+    } catch (const std::invalid_argument& e) {  // Solver::solve's checks of counts and arrays
+      throw py::value_error(e.what());
     }
     // impacts=False: no pass over J (at a million contacts it costs 5-10% of
     // a particle solve); the record is built over no impulses and the key

@@ -161,3 +161,63 @@ def test_unchecked_solve_is_the_same_solve():
     np.copyto(bodies.w, w0)
     J2, _ = collide.solve(bodies, contacts, model="rigid", check=False)
     assert np.array_equal(J1, J2)
+
+
+def _arrays_unchanged(arrays, before):
+    for f, a in arrays.items():
+        assert np.array_equal(a, before[f], equal_nan=True), f
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("kind", ["index", "self"])
+def test_unchecked_solve_builds_a_schedule_that_refuses_bad_indices(dtype, kind):
+    # check=False without a schedule: the library's Schedule::build checks
+    # the indices in its level pass and its std::invalid_argument arrives as
+    # ValueError, before anything is written.
+    arrays, carrays, message = corrupt(kind)
+    arrays = {f: a.astype(dtype) for f, a in arrays.items()}
+    carrays = {f: (a.astype(dtype) if a.dtype.kind == "f" else a) for f, a in carrays.items()}
+    b, c = make(arrays, carrays)
+    before, cbefore = ({f: a.copy() for f, a in d.items()} for d in (arrays, carrays))
+    out = np.full((3, len(c)), 7.0, dtype=dtype)
+    for model in ("auto", "rigid", "particle"):
+        with pytest.raises(ValueError, match="Schedule::build: " + message):
+            collide.solve(b, c, model=model, check=False, out=out)
+        with pytest.raises(ValueError, match="Schedule::build: " + message):
+            collide.Solver(path="scalar").solve(b, c, model=model, check=False, out=out)
+    packed = collide.pack(b, "rigid")
+    records = packed.records.tobytes()
+    with pytest.raises(ValueError, match="Schedule::build: " + message):
+        collide.solve(packed, c, check=False, out=out)
+    assert packed.records.tobytes() == records
+    _arrays_unchanged(arrays, before)
+    _arrays_unchanged(carrays, cbefore)
+    assert np.all(out == 7.0)
+
+
+@pytest.mark.parametrize("kind", ["index", "self"])
+def test_unchecked_solve_with_an_earlier_schedule_refuses_indices_changed_since(kind):
+    # A schedule built while the indices were good, then one index broken in
+    # the caller's array: the solve checks the indices again beside it.
+    arrays, carrays = scene()
+    b, c = make(arrays, carrays)
+    schedule = collide.Schedule(b, c)
+    good = {f: carrays[f].copy() for f in ("a", "b")}
+    _, broken, message = corrupt(kind)
+    for f in ("a", "b"):
+        np.copyto(carrays[f], broken[f])
+    before, cbefore = ({f: a.copy() for f, a in d.items()} for d in (arrays, carrays))
+    out = np.full((3, len(c)), 7.0)
+    for model in ("auto", "rigid"):
+        with pytest.raises(ValueError, match=message):
+            collide.solve(b, c, model=model, schedule=schedule, check=False, out=out)
+        with pytest.raises(ValueError, match=message):
+            collide.Solver().solve(b, c, model=model, schedule=schedule, check=False, out=out)
+    _arrays_unchanged(arrays, before)
+    _arrays_unchanged(carrays, cbefore)
+    assert np.all(out == 7.0)
+    # The same schedule with the indices restored solves as before.
+    for f in ("a", "b"):
+        np.copyto(carrays[f], good[f])
+    J, _ = collide.solve(b, c, schedule=schedule, check=False)
+    assert np.all(np.isfinite(J))

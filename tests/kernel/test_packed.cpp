@@ -16,6 +16,7 @@
 #include "collide/packed.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
+#include "collide/validate.hpp"
 #include "support/scenes.hpp"
 #include "support/solve_helpers.hpp"
 
@@ -260,6 +261,53 @@ TEST(PackedLayout, SolverReusesItsBufferAcrossSizes) {
     Solver(soa).solve(y.bodies.view(), y.contacts.view(), jy.view(), schedule);
     EXPECT_TRUE(same_bodies(x.bodies, y.bodies));
     EXPECT_TRUE(same_impulses(jx, jy));
+  }
+}
+
+TEST(PackedLayout, ParticleSolveNeedsNoContactPoint) {
+  // validate() lets a particle view's contacts have no point (contacts.c
+  // null). The packed path's prefetch of a scattered batch once offset
+  // those null pointers: undefined behaviour, which the UBSan build of this
+  // test reports. The results are those with the point present, on every
+  // path and layout, and so are contact_slice()'s views of such contacts.
+  for (const std::uint64_t seed : {1, 2}) {
+    SceneOptions so;
+    so.seed = seed;
+    const Scene<float> scene = shared_scene<float>(3000, 500, so);
+    Schedule schedule;
+    {
+      Scene<float> s = scene;
+      schedule.build(s.contacts.view(), s.bodies.view());
+    }
+    ContactView<float> no_point = scene.contacts.view();
+    no_point.c = {};
+    Scene<float> probe = scene;
+    ImpulseBuffer<float> probe_j(no_point.count);
+    const Validation valid = validate(particle_view(probe.bodies.view()), no_point, probe_j.view());
+    ASSERT_TRUE(valid) << valid.message;
+    EXPECT_EQ(contact_slice(no_point, 7, 5).c.x, nullptr);
+    for (const Path path : {Path::scalar, Path::simd}) {
+      for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
+        SolverOptions o = options_for(path, 2, 64);
+        o.layout = layout;
+        const Solver solver(o);
+        Scene<float> with = scene, without = scene;
+        ImpulseBuffer<float> jw(scene.contacts.size()), jn(scene.contacts.size());
+        solver.solve(particle_view(with.bodies.view()), with.contacts.view(), jw.view(), schedule);
+        solver.solve(particle_view(without.bodies.view()), no_point, jn.view(), schedule);
+        EXPECT_TRUE(same_bodies(with.bodies, without.bodies)) << to_string(path) << " " << to_string(layout);
+        EXPECT_TRUE(same_impulses(jw, jn)) << to_string(path) << " " << to_string(layout);
+        // The caller's packed records.
+        Scene<float> rec = scene;
+        PackedBuffer<PackedParticle<float>> records(rec.bodies.size());
+        pack(particle_view(rec.bodies.view()), packed_view(records));
+        ImpulseBuffer<float> jr(scene.contacts.size());
+        solver.solve(packed_view(records), no_point, jr.view(), schedule);
+        unpack_velocities(packed_view(records), particle_view(rec.bodies.view()));
+        EXPECT_TRUE(same_bodies(with.bodies, rec.bodies)) << to_string(path);
+        EXPECT_TRUE(same_impulses(jw, jr)) << to_string(path);
+      }
+    }
   }
 }
 

@@ -34,15 +34,16 @@ struct ContactView {
 };
 
 /// Contacts first .. first + count - 1 of `v`, as a view of the same arrays
-/// (no copy, no renormalising). Requires first + count <= v.count.
+/// (no copy, no renormalising). Requires first + count <= v.count. Null
+/// arrays stay null (e, mu, and c, which a particle solve does not need).
 template <class T>
 ContactView<T> contact_slice(ContactView<T> v, std::size_t first, std::size_t count) {
   v.count = count;
   v.a += first;
   v.b += first;
-  v.c.x += first;
-  v.c.y += first;
-  v.c.z += first;
+  if (v.c.x) v.c.x += first;
+  if (v.c.y) v.c.y += first;
+  if (v.c.z) v.c.z += first;
   v.n.x += first;
   v.n.y += first;
   v.n.z += first;

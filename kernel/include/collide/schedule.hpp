@@ -48,12 +48,20 @@ namespace collide {
 class Schedule {
  public:
   /// Builds the schedule. Bodies with inv_mass == 0 do not conflict.
-  /// Precondition: every index is < bodies.count (see validate()).
   /// `bodies` is any body view (BodyView, SphereView, ParticleView): only
   /// its count and inverse masses are read. `threads`: at most this many
   /// threads; 0 means the concurrency of the calling thread's task arena.
-  /// The result does not depend on it. Throws std::invalid_argument if
-  /// threads < 0 and std::length_error beyond 2^32 - 2 contacts.
+  /// The result does not depend on it.
+  /// Checked in every build type, before an index is used: every index is
+  /// < bodies.count and a != b in every contact; std::invalid_argument
+  /// naming the first contact that breaks it ("collide::Schedule::build:
+  /// contacts.a[17] = 40: out of range (8 bodies)"). Also
+  /// std::invalid_argument if threads < 0 or contacts.a, contacts.b or the
+  /// inverse masses are null with a count > 0, and std::length_error beyond
+  /// 2^32 - 2 contacts. A build that throws leaves the schedule empty
+  /// (contact_count(), body_count() and batch_count() are 0), so no solve of
+  /// the scene can use it. The values (inverse masses, ...) are not checked:
+  /// that is validate()'s.
   template <class T, template <class> class View>
   void build(const ContactView<T>& contacts, const View<T>& bodies, int threads = 0) {
     build(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass), threads);
@@ -70,7 +78,7 @@ class Schedule {
   void build(const ContactView<typename PackedValue<Record>::type>& contacts, const PackedView<Record>& bodies,
              int threads = 0) {
     using T = typename PackedValue<Record>::type;
-    const T* inv_mass = bodies.count != 0 ? &bodies.bodies->inv_mass : nullptr;
+    const T* inv_mass = bodies.count != 0 && bodies.bodies != nullptr ? &bodies.bodies->inv_mass : nullptr;
     build_strided(contacts, bodies.count, inv_mass, sizeof(Record) / sizeof(T), threads);
   }
   template <class T>

@@ -179,9 +179,19 @@ class Solver {
   [[nodiscard]] IsaChoice isa_choice() const;
 
   /// Resolves every contact: updates v and w of movable bodies and writes J.
-  /// Preconditions (checked by validate(), asserted in debug builds): the
-  /// schedule was built for these contacts and bodies, impulses.count ==
-  /// contacts.count, indices in range, a != b, finite inputs.
+  /// Checked in every build type before anything is read or written
+  /// (std::invalid_argument naming the counts or the array): the schedule
+  /// was built for as many contacts and bodies as the views hold
+  /// (schedule.contact_count() == contacts.count, schedule.body_count() ==
+  /// bodies.count), impulses.count == contacts.count, and no array the
+  /// model reads is null while its count is > 0 (contacts.c may be null for
+  /// the particle model; e and mu are optional). Schedule::build checked
+  /// every index against the body count; the schedule must have been built
+  /// from these contacts' indices, unchanged since (a schedule is reused
+  /// while they do not change). Precondition, not checked here: the values
+  /// obey validate()'s rules (finite, unit normals and quaternions, e in
+  /// [0, 1], ...); values that do not may give NaN or inf but stay inside
+  /// the arrays.
   template <class T>
   SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                    const Schedule& schedule) const;
@@ -223,8 +233,12 @@ class Solver {
   std::unique_ptr<Impl> impl_;
 };
 
-/// One-shot convenience: builds a schedule and a solver and solves with the
-/// cheapest model that fits (choose_model()).
+/// One-shot convenience: checks the input with validate() first, then builds
+/// a schedule and a solver and solves with the cheapest model that fits
+/// (choose_model()). Input that validate() rejects throws
+/// std::invalid_argument carrying validate()'s message ("collide::solve:
+/// contacts.b[17] = 40: out of range (8 bodies)") and nothing is written;
+/// options the Solver refuses throw as its constructor does.
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                  const SolverOptions& options = {});

@@ -1,12 +1,16 @@
 // collide/validate.hpp - checking views before they reach a kernel.
 //
-// The kernels trust their input: in release builds they check nothing, in
-// debug builds they assert the cheap preconditions (index range, a != b, view
-// sizes). A caller that hands over its own arrays calls validate() at the
-// boundary, once per scene or whenever the data may be bad. The views hold
-// inverse units; the rules for physical units (what a scene file or a
-// BodyRecord holds: m > 0, 1/m finite, ...) are collide/rules.hpp's, which
-// the file reader and the buffers apply. The unit tolerance is the same.
+// The kernels trust the values of their input; what keeps them inside the
+// arrays is checked in every build type: Schedule::build checks every index
+// (< bodies.count, a != b), and Solver::solve the counts (the schedule's
+// against the views', impulses against contacts) and that no array it reads
+// is null. The values (finite, unit normals, e in [0, 1], ...) are the
+// caller's: a caller that hands over its own arrays calls validate() at the
+// boundary, once per scene or whenever the data may be bad, and the one-shot
+// collide::solve() calls it itself. The views hold inverse units; the rules
+// for physical units (what a scene file or a BodyRecord holds: m > 0, 1/m
+// finite, ...) are collide/rules.hpp's, which the file reader and the
+// buffers apply. The normal tolerance and the quaternion rule are the same.
 #pragma once
 
 #include <string>
