@@ -286,13 +286,15 @@ void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_co
                              std::size_t stride, int threads) {
   // Empty until the build succeeds: a build that throws leaves a schedule of
   // nothing (the buffers keep their capacity), which no solve of a non-empty
-  // scene accepts (Solver::solve compares the counts).
+  // scene accepts (Solver::solve compares the counts). order_ keeps its size:
+  // every entry is rewritten by a build that succeeds, and clearing it made
+  // the resize below write the whole array once more (a fifth of the pairs
+  // scene's build).
   const auto reset = [this] {
     contact_count_ = 0;
     body_count_ = 0;
     largest_batch_ = 0;
     conflicts_ = 0;
-    order_.clear();
     batch_begin_.clear();
     contiguous_.clear();
   };
