@@ -37,8 +37,8 @@
 
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
-#include "isa_calibration.hpp"
 #include "collide/validate.hpp"
+#include "isa_calibration.hpp"
 #include "kernel_table.hpp"
 #include "scratch_records.hpp"
 
