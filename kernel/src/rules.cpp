@@ -16,17 +16,6 @@
 namespace collide {
 namespace {
 
-template <class T>
-constexpr const char* precision_name() {
-  if constexpr (std::is_same_v<T, float>) {
-    return "float";
-  } else if constexpr (std::is_same_v<T, double>) {
-    return "double";
-  } else {
-    return "long double";
-  }
-}
-
 /// The shortest text that reads back to the same T ("inf", "-0", "nan").
 template <class T>
 std::string number(T value) {

@@ -234,11 +234,6 @@ std::string quoted(std::string_view field) {
   return s;
 }
 
-template <class T>
-constexpr const char* precision_name() {
-  return std::is_same_v<T, float> ? "float" : "double";
-}
-
 /// Walks the comma-separated fields of one line.
 class FieldCursor {
  public:

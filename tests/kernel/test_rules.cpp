@@ -512,12 +512,16 @@ TYPED_TEST(Rules, VerdictsAndBothReaderPathsAgree) {
     for (const std::string& t : {bodies, with_blanks(bodies)}) {
       const std::optional<SceneError> e = scene_error([&] { (void)parse_bodies<T>(t, "b"); });
       ASSERT_EQ(e.has_value(), bd.has_value()) << t;
-      if (e) ASSERT_EQ(e->reason(), bd->reason) << t;
+      if (e) {
+        ASSERT_EQ(e->reason(), bd->reason) << t;
+      }
     }
     for (const std::string& t : {contacts, with_blanks(contacts)}) {
       const std::optional<SceneError> e = scene_error([&] { (void)parse_contacts<T>(t, "c", kBodies); });
       ASSERT_EQ(e.has_value(), cd.has_value()) << t;
-      if (e) ASSERT_EQ(e->reason(), cd->reason) << t;
+      if (e) {
+        ASSERT_EQ(e->reason(), cd->reason) << t;
+      }
     }
   }
   EXPECT_GT(rejected, 100);

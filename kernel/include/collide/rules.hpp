@@ -46,6 +46,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
@@ -61,6 +62,18 @@ inline constexpr std::array<std::string_view, 10> kContactColumns = {"a",  "b", 
 
 /// Allowed deviation of |n| from 1.
 inline constexpr double kNormalTolerance = 1e-3;
+
+/// "float", "double" or "long double": the precision a reason names.
+template <class T>
+constexpr const char* precision_name() {
+  if constexpr (std::is_same_v<T, float>) {
+    return "float";
+  } else if constexpr (std::is_same_v<T, double>) {
+    return "double";
+  } else {
+    return "long double";
+  }
+}
 
 /// No body count to check ids against (a != b is still checked).
 inline constexpr std::size_t kUnknownBodyCount = static_cast<std::size_t>(-1);

@@ -69,6 +69,7 @@
 #include "collide/model.hpp"
 #include "collide/reference.hpp"
 #include "collide/report.hpp"
+#include "collide/rules.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
 #include "collide/schedule.hpp"
@@ -127,17 +128,6 @@ class Progress {
 
 enum class SceneKind { pairs, debris };
 const char* scene_name(SceneKind kind) { return kind == SceneKind::pairs ? "pairs" : "debris"; }
-
-template <class T>
-const char* precision_name() {
-  if constexpr (std::is_same_v<T, float>) {
-    return "float";
-  } else if constexpr (std::is_same_v<T, double>) {
-    return "double";
-  } else {
-    return "long double";
-  }
-}
 
 template <class T>
 Scene<T> make_scene(SceneKind kind, std::size_t n, bool friction, std::uint64_t seed) {
