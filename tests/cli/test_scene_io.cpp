@@ -24,6 +24,7 @@
 
 #include "collide/generate.hpp"
 #include "collide/scene_io.hpp"
+#include "support/csv_text.hpp"
 
 namespace fs = std::filesystem;
 using collide::BodyTable;
@@ -226,15 +227,7 @@ TEST(SceneIo, LargeFileReportsTheFirstBadRow) {
   EXPECT_EQ(e.column(), "m");
 }
 
-/// A blank after every comma sends every row down the careful path.
-std::string with_blanks(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    out += c;
-    if (c == ',') out += ' ';
-  }
-  return out;
-}
+using collide::test::with_blanks;
 
 TEST(SceneIo, FastAndCarefulPathsAgree) {
   std::string bodies = kHeader, contacts = kContactHeader;

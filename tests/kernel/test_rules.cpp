@@ -38,6 +38,7 @@
 #include "collide/contacts.hpp"
 #include "collide/rules.hpp"
 #include "collide/scene_io.hpp"
+#include "support/csv_text.hpp"
 
 namespace collide::test {
 namespace {
@@ -335,16 +336,6 @@ std::string contact_file(const std::vector<ContactRecord<T>>& rows) {
   std::string text(contacts_header());
   for (const ContactRecord<T>& r : rows) append_contact_row(text, r);
   return text;
-}
-
-/// A blank after every comma sends every row down the reader's careful path.
-std::string with_blanks(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    out += c;
-    if (c == ',') out += ' ';
-  }
-  return out;
 }
 
 template <class F>
