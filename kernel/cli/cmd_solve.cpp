@@ -28,6 +28,11 @@
 //   quantity kImpulseErrorBoundEps bounds (error_bound.hpp).
 // * --threads N also caps the tbb threads of parsing and writing, so
 //   "--threads 1" means one thread everywhere.
+// * Each scene file is CSV or binary (.npz) by its name, or all of them as
+//   --format says (collide/scene_npz.hpp). A binary input is mapped and its
+//   columns used in place; without --precision a binary scene is solved in
+//   its own precision (converting it would cost what mapping saves), a CSV
+//   one in double.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -49,6 +54,7 @@
 #include "collide/reference.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
+#include "collide/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "commands.hpp"
@@ -57,7 +63,8 @@ namespace collide::cli {
 
 const char* const kSolveUsage =
     "usage: collide solve --bodies B.csv --contacts C.csv --out-bodies OB.csv --out-impulses OJ.csv\n"
-    "                     [--precision float|double] [--threads N] [--path simd|scalar]\n"
+    "                     [--format csv|npz] [--precision float|double] [--threads N]\n"
+    "                     [--path simd|scalar]\n"
     "                     [--isa auto|sse2|avx2|avx512] [--layout auto|soa|packed]\n"
     "                     [--accuracy fast|accurate]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
@@ -72,7 +79,11 @@ const char* const kSolveUsage =
     "                        atomically; '-' (stdout), a device such as /dev/null\n"
     "                        or a FIFO is written in place\n"
     "  --out-impulses FILE   result impulses file, likewise (only one output may be '-')\n"
-    "  --precision P         float or double (default double)\n"
+    "  --format F            csv or npz for every file above (default: npz for a name\n"
+    "                        ending in .npz, the binary scene format, else csv);\n"
+    "                        inputs and outputs may differ\n"
+    "  --precision P         float or double (default: a binary scene's own, else\n"
+    "                        double)\n"
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
     "  --path P              simd (default) or scalar; results do not depend on it\n"
@@ -107,6 +118,8 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 
 struct SolveRequest {
   std::string bodies_path, contacts_path, out_bodies_path, out_impulses_path;
+  SceneFormat bodies_format = SceneFormat::csv, contacts_format = SceneFormat::csv;
+  SceneFormat out_bodies_format = SceneFormat::csv, out_impulses_format = SceneFormat::csv;
   bool want_float = false;
   int threads = 0;
   Path path = Path::simd;
@@ -122,9 +135,9 @@ struct SolveRequest {
 template <class T>
 int solve_scene(const SolveRequest& req) {
   const auto t_read = Clock::now();
-  const BodyTable<T> table = read_bodies<T>(req.bodies_path);
-  const ContactBuffer<T> contacts = read_contacts<T>(req.contacts_path, table.size());
-  BodyBuffer<T> bodies = to_body_buffer(table);
+  const LoadedBodies<T> table = load_bodies<T>(req.bodies_path, req.bodies_format);
+  const LoadedContacts<T> contacts = load_contacts<T>(req.contacts_path, req.contacts_format, table.size());
+  BodyBuffer<T> bodies = table.buffer();
   const double read_seconds = seconds_since(t_read);
 
   // The reference must see the inputs the kernel sees: copy before solving.
@@ -177,7 +190,13 @@ int solve_scene(const SolveRequest& req) {
     OutputFile out_impulses(req.out_impulses_path);
     const auto write = [&](OutputFile& out) {
       if (&out == &out_bodies) {
-        write_bodies(out_bodies, table, std::as_const(bodies).view());
+        if (req.out_bodies_format == SceneFormat::npz) {
+          write_bodies_npz(out_bodies, table.columns(), std::as_const(bodies).view());
+        } else {
+          write_bodies(out_bodies, table.columns(), std::as_const(bodies).view());
+        }
+      } else if (req.out_impulses_format == SceneFormat::npz) {
+        write_impulses_npz(out_impulses, std::as_const(impulses).view());
       } else {
         write_impulses(out_impulses, std::as_const(impulses).view());
       }
@@ -237,7 +256,8 @@ int run_solve(int argc, char** argv) {
                                      {"accuracy", true},
                                      {"model", true},
                                      {"stats", false},
-                                     {"check", false}});
+                                     {"check", false},
+                                     {"format", true}});
   if (opt.count("help") != 0) {
     std::fputs(kSolveUsage, stdout);
     return kExitOk;
@@ -261,11 +281,31 @@ int run_solve(int argc, char** argv) {
       throw UsageError("--out-bodies and --out-impulses must be different files");
     }
   }
+  if (const auto it = opt.find("format"); it != opt.end()) {
+    try {
+      const SceneFormat f = parse_scene_format(it->second);
+      req.bodies_format = req.contacts_format = req.out_bodies_format = req.out_impulses_format = f;
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--format: ") + e.what());
+    }
+  } else {
+    req.bodies_format = scene_format_of(req.bodies_path);
+    req.contacts_format = scene_format_of(req.contacts_path);
+    req.out_bodies_format = scene_format_of(req.out_bodies_path);
+    req.out_impulses_format = scene_format_of(req.out_impulses_path);
+  }
   if (const auto it = opt.find("precision"); it != opt.end()) {
     if (it->second != "float" && it->second != "double") {
       throw UsageError("--precision must be float or double, got '" + it->second + "'");
     }
     req.want_float = it->second == "float";
+  } else if (req.bodies_format == SceneFormat::npz) {
+    // A binary scene runs in its own precision; a bad file is reported (exit
+    // 1) when it is read.
+    try {
+      req.want_float = npz_scene_precision(NpzArchive::map(req.bodies_path)) == NpyType::f4;
+    } catch (const SceneError&) {
+    }
   }
   if (const auto it = opt.find("threads"); it != opt.end()) {
     const unsigned long long n = parse_count("threads", it->second);

@@ -47,9 +47,11 @@ unsigned long long parse_count(const std::string& name, const std::string& value
 int run_solve(int argc, char** argv);
 int run_gen(int argc, char** argv);
 int run_report(int argc, char** argv);
+int run_convert(int argc, char** argv);
 
 extern const char* const kSolveUsage;
 extern const char* const kGenUsage;
 extern const char* const kReportUsage;
+extern const char* const kConvertUsage;
 
 }  // namespace collide::cli

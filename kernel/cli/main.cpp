@@ -22,9 +22,10 @@ const char* const kMainUsage =
     "Batched rigid-body collision impulses (see docs/collision-law.md).\n"
     "\n"
     "commands:\n"
-    "  solve   resolve the contacts of a scene: read bodies.csv and contacts.csv,\n"
+    "  solve   resolve the contacts of a scene: read its bodies and contacts files,\n"
     "          write the bodies with their new velocities and the impulses\n"
-    "  gen     write a random scene (pairs or debris) as bodies.csv and contacts.csv\n"
+    "  gen     write a random scene (pairs or debris) as bodies and contacts files\n"
+    "  convert convert a scene file between CSV and the binary format (.npz)\n"
     "  report  measure every variant's speed and error on millions of random\n"
     "          collisions: a table, and optionally JSON and a PNG plot\n"
     "\n"
@@ -108,10 +109,14 @@ int main(int argc, char** argv) {
     if (command == "solve") return run_solve(argc, argv);
     if (command == "gen") return run_gen(argc, argv);
     if (command == "report") return run_report(argc, argv);
+    if (command == "convert") return run_convert(argc, argv);
     std::fprintf(stderr, "collide: unknown command '%s'\n\n%s", argv[1], kMainUsage);
     return kExitUsage;
   } catch (const UsageError& e) {
-    const char* usage = command == "solve" ? kSolveUsage : command == "report" ? kReportUsage : kGenUsage;
+    const char* usage = command == "solve"     ? kSolveUsage
+                        : command == "report"  ? kReportUsage
+                        : command == "convert" ? kConvertUsage
+                                               : kGenUsage;
     std::fprintf(stderr, "collide %s: %s\n\n%s", argv[1], e.what(), usage);
     return kExitUsage;
   } catch (const std::bad_alloc&) {

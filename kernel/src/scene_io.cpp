@@ -30,6 +30,8 @@
 //   for any thread count.
 #include "collide/scene_io.hpp"
 
+#include "body_fill.hpp"
+
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -52,6 +54,7 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_pipeline.h>
+#include <oneapi/tbb/parallel_reduce.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
 
@@ -573,13 +576,49 @@ BodyTable<T> read_bodies(const std::string& path) {
 }
 
 template <class T>
-BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
+BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table) {
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
+  // The rules first, in parallel and without messages (body_ok); a table
+  // that breaks one goes through set(), which names the first defect as it
+  // always has.
+  const bool ok = oneapi::tbb::parallel_reduce(
+      Range(0, table.size(), 1 << 14), true,
+      [&](const Range& r, bool so_far) {
+        for (std::size_t i = r.begin(); so_far && i != r.end(); ++i) so_far = body_ok(table.record(i));
+        return so_far;
+      },
+      [](bool x, bool y) { return x && y; });
+  if (!ok) {
+    BodyBuffer<T> named(table.size());
+    for (std::size_t i = 0; i < table.size(); ++i) named.set(i, table.record(i));  // throws at the first defect
+  }
+  return detail::fill_body_buffer(table);
+}
+
+template <class T>
+BodyBuffer<T> detail::fill_body_buffer(const BodyColumns<T>& table) {
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
   BodyBuffer<T> bodies(table.size());
-  // set() writes element i of each array only, so disjoint ranges are safe.
-  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, table.size(), 1 << 14),
-                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t i = r.begin(); i != r.end(); ++i) bodies.set(i, table.record(i));
-                            });
+  // Column by column: q, p, v and w are copied as they are, m and I
+  // inverted as BodyBuffer::set inverts them (1/inf = 0; an immovable body
+  // has no inverse moments). Disjoint row ranges, so threads never share an
+  // element.
+  BodyView<T> v = bodies.view();
+  T* const copied[13] = {v.q.w, v.q.x, v.q.y, v.q.z, v.p.x, v.p.y, v.p.z, v.v.x, v.v.y, v.v.z, v.w.x, v.w.y, v.w.z};
+  oneapi::tbb::parallel_for(Range(0, table.size(), 1 << 16), [&](const Range& r) {
+    const std::size_t i0 = r.begin(), n = r.size();
+    for (std::size_t k = 0; k < 13; ++k) std::memcpy(copied[k] + i0, table.column[4 + k] + i0, n * sizeof(T));
+    const T inf = std::numeric_limits<T>::infinity();
+    for (std::size_t i = i0; i != r.end(); ++i) {
+      const T m = table.column[0][i];
+      const bool immovable = m == inf;
+      v.inv_mass[i] = immovable ? T(0) : T(1) / m;
+      const T ix = table.column[1][i], iy = table.column[2][i], iz = table.column[3][i];
+      v.inv_inertia.x[i] = immovable || ix == inf ? T(0) : T(1) / ix;
+      v.inv_inertia.y[i] = immovable || iy == inf ? T(0) : T(1) / iy;
+      v.inv_inertia.z[i] = immovable || iz == inf ? T(0) : T(1) / iz;
+    }
+  });
   return bodies;
 }
 
@@ -734,7 +773,7 @@ void emit_rows(Sink&& sink, std::string_view header, std::size_t rows, std::size
 }
 
 template <class T>
-auto body_result_row(const BodyTable<T>& inputs, const BodyView<const T>& solved) {
+auto body_result_row(const BodyColumns<T>& inputs, const BodyView<const T>& solved) {
   return [&inputs, solved](char* p, std::size_t i) {
     using Table = BodyTable<T>;
     for (std::size_t k = 0; k < Table::vx; ++k) {
@@ -751,7 +790,7 @@ auto body_result_row(const BodyTable<T>& inputs, const BodyView<const T>& solved
 }
 
 template <class T>
-auto body_table_row(const BodyTable<T>& table) {
+auto body_table_row(const BodyColumns<T>& table) {
   return [&table](char* p, std::size_t i) {
     for (std::size_t k = 0; k < 17; ++k) {
       p = put_number(p, table.column[k][i]);
@@ -804,7 +843,7 @@ auto contact_row(const ContactView<T>& contacts) {
 }
 
 template <class T>
-void check_same_count(const BodyTable<T>& inputs, const BodyView<const T>& solved, const std::string& file) {
+void check_same_count(const BodyColumns<T>& inputs, const BodyView<const T>& solved, const std::string& file) {
   if (inputs.size() != solved.count) {
     throw SceneError(file, "internal error: " + std::to_string(inputs.size()) + " input bodies but " +
                                std::to_string(solved.count) + " solved bodies");
@@ -822,7 +861,7 @@ std::string_view contacts_header() { return "a,b,cx,cy,cz,nx,ny,nz,e,mu\n"; }
 std::string_view impulses_header() { return "jx,jy,jz\n"; }
 
 template <class T>
-void write_bodies(OutputFile& out, const BodyTable<T>& inputs, const BodyView<const T>& solved) {
+void write_bodies(OutputFile& out, const BodyColumns<T>& inputs, const BodyView<const T>& solved) {
   check_same_count(inputs, solved, out.path());
   emit_rows([&](std::string_view s) { out.write(s); }, bodies_header(), inputs.size(), kBodyRowChars,
             body_result_row(inputs, solved));
@@ -835,7 +874,7 @@ void write_impulses(OutputFile& out, const ImpulseView<const T>& impulses) {
 }
 
 template <class T>
-void write_body_table(OutputFile& out, const BodyTable<T>& table) {
+void write_body_table(OutputFile& out, const BodyColumns<T>& table) {
   emit_rows([&](std::string_view s) { out.write(s); }, bodies_header(), table.size(), kBodyRowChars,
             body_table_row(table));
 }
@@ -847,7 +886,7 @@ void write_contacts(OutputFile& out, const ContactView<T>& contacts) {
 }
 
 template <class T>
-std::string format_body_table(const BodyTable<T>& table) {
+std::string format_body_table(const BodyColumns<T>& table) {
   std::string text;
   emit_rows([&](std::string_view s) { text.append(s); }, bodies_header(), table.size(), kBodyRowChars,
             body_table_row(table));
@@ -863,7 +902,7 @@ std::string format_contacts(const ContactView<T>& contacts) {
 }
 
 template <class T>
-std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved) {
+std::string format_bodies(const BodyColumns<T>& inputs, const BodyView<const T>& solved) {
   check_same_count(inputs, solved, "<memory>");
   std::string text;
   emit_rows([&](std::string_view s) { text.append(s); }, bodies_header(), inputs.size(), kBodyRowChars,
@@ -910,17 +949,18 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template struct BodyTable<T>;                                                                 \
   template BodyTable<T> parse_bodies<T>(std::string_view, std::string_view);                    \
   template BodyTable<T> read_bodies<T>(const std::string&);                                     \
-  template BodyBuffer<T> to_body_buffer<T>(const BodyTable<T>&);                                \
+  template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                              \
+  template BodyBuffer<T> detail::fill_body_buffer<T>(const BodyColumns<T>&);                    \
   template ContactBuffer<T> parse_contacts<T>(std::string_view, std::string_view, std::size_t); \
   template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);                  \
-  template void write_bodies<T>(OutputFile&, const BodyTable<T>&, const BodyView<const T>&);    \
+  template void write_bodies<T>(OutputFile&, const BodyColumns<T>&, const BodyView<const T>&);  \
   template void write_impulses<T>(OutputFile&, const ImpulseView<const T>&);                    \
-  template void write_body_table<T>(OutputFile&, const BodyTable<T>&);                          \
+  template void write_body_table<T>(OutputFile&, const BodyColumns<T>&);                        \
   template void write_contacts<T>(OutputFile&, const ContactView<T>&);                          \
-  template std::string format_body_table<T>(const BodyTable<T>&);                               \
+  template std::string format_body_table<T>(const BodyColumns<T>&);                             \
   template std::string format_contacts<T>(const ContactView<T>&);                               \
   template BodyTable<T> to_body_table<T>(const BodyView<const T>&);                             \
-  template std::string format_bodies<T>(const BodyTable<T>&, const BodyView<const T>&);         \
+  template std::string format_bodies<T>(const BodyColumns<T>&, const BodyView<const T>&);       \
   template std::string format_impulses<T>(const ImpulseView<const T>&);                         \
   template void append_number<T>(std::string&, T);                                              \
   template void append_body_row<T>(std::string&, const BodyRecord<T>&);                         \

@@ -26,6 +26,7 @@ from . import _collide
 from ._collide import (
     Bodies,
     Contacts,
+    MappedFile,
     PackedBodies,
     Reference,
     Schedule,
@@ -38,6 +39,7 @@ from ._collide import (
 __all__ = [
     "Bodies",
     "Contacts",
+    "MappedFile",
     "PackedBodies",
     "Reference",
     "Schedule",
@@ -48,11 +50,13 @@ __all__ = [
     "from_physical",
     "generate",
     "impulse_error",
+    "load",
     "pack",
     "packed_dtype",
     "packed_empty",
     "read_scene",
     "reference_solve",
+    "save",
     "report",
     "report_hard",
     "best_isa",
@@ -135,6 +139,28 @@ def read_scene(bodies_csv, contacts_csv, dtype=_np.float64):
     cannot be read (missing, a directory, no permission) OSError naming the
     path (FileNotFoundError, IsADirectoryError, PermissionError...)."""
     return _collide.read_scene(str(bodies_csv), str(contacts_csv), dtype=dtype)
+
+
+def load(bodies, contacts, *, dtype=None):
+    """Reads a scene's bodies and contacts files and returns ``(Bodies,
+    Contacts)`` for :func:`solve`. Each file is binary (NumPy's uncompressed
+    ``.npz``, one array per column; docs/collision-law.md) when its name ends
+    in ``.npz``, else CSV. A binary scene is mapped, not parsed: its arrays
+    that the solver only reads (``q``, ``p`` and every contact array) are
+    read-only views of the file's pages, whose ``base`` is a
+    :class:`MappedFile`; the inverses are computed and ``v``, ``w`` copied,
+    since a solve writes them. ``dtype`` defaults to a binary file's own
+    precision (float64 for CSV); another one converts. Every value is checked
+    with the rules of the CSV reader: ValueError naming file, row and column;
+    OSError for a file that cannot be read."""
+    return _collide.load(str(bodies), str(contacts), dtype=dtype)
+
+
+def save(bodies_path, contacts_path, bodies, contacts):
+    """Writes ``bodies`` and ``contacts`` as scene files, binary (``.npz``)
+    or CSV by each name, as :func:`write_scene` does: both replaced
+    atomically, or neither. ``numpy.load`` reads the binary files."""
+    write_scene(bodies_path, contacts_path, bodies, contacts)
 
 
 def write_scene(bodies_csv, contacts_csv, bodies, contacts):

@@ -2,6 +2,8 @@
 
 from typing import Any, Literal, Sequence
 
+import os
+
 import numpy as np
 import numpy.typing as npt
 
@@ -38,6 +40,12 @@ class Bodies:
         w: FloatArray,
     ) -> None: ...
     def __len__(self) -> int: ...
+
+class MappedFile:
+    """A scene file mapped into memory: the base of the arrays load() leaves in it."""
+    path: str
+    address: int
+    size: int
 
 class Contacts:
     """M contacts: a, b uint32 (M,), c, n (3, M), e and mu (M,) or None."""
@@ -166,6 +174,10 @@ def generate(
 ) -> tuple[Bodies, Contacts]: ...
 def read_scene(bodies_csv: str, contacts_csv: str, dtype: type[Float] | np.dtype[Any] = ...) -> tuple[Bodies, Contacts]: ...
 def write_scene(bodies_csv: str, contacts_csv: str, bodies: AnyBodies, contacts: Contacts) -> None: ...
+def load(
+    bodies: str | os.PathLike[str], contacts: str | os.PathLike[str], *, dtype: type[Float] | np.dtype[Any] | None = ...
+) -> tuple[Bodies, Contacts]: ...
+def save(bodies_path: str | os.PathLike[str], contacts_path: str | os.PathLike[str], bodies: AnyBodies, contacts: Contacts) -> None: ...
 def packed_dtype(model: Literal["rigid", "sphere", "particle"] = "rigid", dtype: type[Float] | np.dtype[Any] = ...) -> np.dtype[Any]: ...
 def packed_empty(
     n: int,

@@ -62,6 +62,7 @@
 #include "collide/rules.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
+#include "collide/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/validate.hpp"
@@ -116,7 +117,13 @@ py::array checked_array(const std::string& owner, const char* name, const py::ha
                          (rows == 0 ? std::string("(N,)") : "(" + std::to_string(rows) + ", N)"));
   }
   const int flags = a.flags();
-  if ((flags & py::array::c_style) == 0) {
+  // C-contiguous, or (for a (rows, N) array) each row contiguous with the
+  // rows apart: what a scene file loaded in place gives (collide.load), its
+  // columns at one stride in the mapping.
+  const auto item = static_cast<py::ssize_t>(a.itemsize());
+  const bool rows_contiguous = rows != 0 && a.shape(1) > 0 && a.strides(1) == item && a.strides(0) % item == 0 &&
+                               a.strides(0) >= a.shape(1) * item;
+  if ((flags & py::array::c_style) == 0 && !rows_contiguous) {
     throw py::type_error(what + " must be C-contiguous (numpy.ascontiguousarray makes a contiguous copy)");
   }
   if ((flags & py::detail::npy_api::NPY_ARRAY_ALIGNED_) == 0) throw py::type_error(what + " must be aligned");
@@ -139,11 +146,14 @@ template <class T>
 T* data(const py::array& a) {
   return static_cast<T*>(const_cast<void*>(a.data()));
 }
+/// Row r of a (rows, N) array (rows contiguous, checked_array).
+template <class T>
+T* row(const py::array& a, py::ssize_t r) {
+  return reinterpret_cast<T*>(static_cast<char*>(const_cast<void*>(a.data())) + r * a.strides(0));
+}
 template <class T>
 Vec3Array<T> vec3(const py::array& a) {
-  T* p = data<T>(a);
-  const std::size_t n = length(a);
-  return {p, p + n, p + 2 * n};
+  return {row<T>(a, 0), row<T>(a, 1), row<T>(a, 2)};
 }
 
 /// The dtype of a scene, from its first floating-point array `what`.
@@ -193,11 +203,10 @@ struct Bodies {
 
   template <class T>
   BodyView<T> view() const {
-    T* iq = data<T>(q);
     return {count,
             data<T>(inv_mass),
             vec3<T>(inv_inertia),
-            {iq, iq + count, iq + 2 * count, iq + 3 * count},
+            {row<T>(q, 0), row<T>(q, 1), row<T>(q, 2), row<T>(q, 3)},
             vec3<T>(p),
             vec3<T>(v),
             vec3<T>(w)};
@@ -1016,6 +1025,147 @@ py::tuple read_scene_py(const std::string& bodies_csv, const std::string& contac
   return d == Dtype::f32 ? run(float{}) : run(double{});
 }
 
+// ---------------------------------------------------------------------------
+// Scene files in either format, the binary one mapped (collide.load/save).
+// ---------------------------------------------------------------------------
+
+/// What keeps a loaded file's mapping alive: the base object of every array
+/// that points into it. `address` and `size` say where the mapping lies, so
+/// a caller (and the tests) can tell a view from a copy.
+struct MappedFile {
+  std::shared_ptr<const void> owner;
+  std::string path;
+  std::uintptr_t address = 0;
+  std::size_t size = 0;
+};
+
+/// A (rows, n) array over columns `cols` where they lie, when they lie one
+/// stride apart in `file`'s mapping (as collide's writer places them), read
+/// only; else a copy.
+template <class T>
+py::array columns_array(Dtype d, const std::vector<const T*>& cols, std::size_t n, const py::object& file,
+                        const MappedFile& mapped) {
+  const auto inside = [&](const T* p) {
+    const auto a = reinterpret_cast<std::uintptr_t>(p);
+    return mapped.size != 0 && a >= mapped.address && a + n * sizeof(T) <= mapped.address + mapped.size;
+  };
+  bool in_place = n > 0;
+  std::ptrdiff_t stride = 0;
+  for (std::size_t r = 0; r < cols.size() && in_place; ++r) {
+    in_place = inside(cols[r]);
+    if (r == 1) stride = reinterpret_cast<const char*>(cols[1]) - reinterpret_cast<const char*>(cols[0]);
+    if (r >= 1 && in_place) {
+      in_place = stride >= static_cast<std::ptrdiff_t>(n * sizeof(T)) &&
+                 reinterpret_cast<const char*>(cols[r]) - reinterpret_cast<const char*>(cols[r - 1]) == stride;
+    }
+  }
+  if (!in_place) {
+    py::array a = cols.size() == 1 ? new_array(d, {static_cast<py::ssize_t>(n)})
+                                   : new_array(d, {static_cast<py::ssize_t>(cols.size()), static_cast<py::ssize_t>(n)});
+    T* o = data<T>(a);
+    for (const T* c : cols) {
+      std::copy(c, c + n, o);
+      o += n;
+    }
+    return a;
+  }
+  std::vector<py::ssize_t> shape, strides;
+  if (cols.size() > 1) {
+    shape.push_back(static_cast<py::ssize_t>(cols.size()));
+    strides.push_back(stride);
+  }
+  shape.push_back(static_cast<py::ssize_t>(n));
+  strides.push_back(sizeof(T));
+  py::array a(numpy_dtype(d), shape, strides, cols[0], file);
+  // The mapping is private and read-only: the array says so.
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  return a;
+}
+
+template <class T>
+py::tuple load_t(const std::string& bodies_path, const std::string& contacts_path, Dtype d) {
+  std::shared_ptr<LoadedBodies<T>> lb;
+  std::shared_ptr<LoadedContacts<T>> lc;
+  translate_io([&] {
+    py::gil_scoped_release release;
+    lb = std::make_shared<LoadedBodies<T>>(load_bodies<T>(bodies_path, scene_format_of(bodies_path)));
+    lc = std::make_shared<LoadedContacts<T>>(
+        load_contacts<T>(contacts_path, scene_format_of(contacts_path), lb->size()));
+    return 0;
+  });
+  const auto file_object = [](std::shared_ptr<const void> owner, const std::string& path, std::string_view bytes) {
+    MappedFile f{std::move(owner), path, reinterpret_cast<std::uintptr_t>(bytes.data()), bytes.size()};
+    return py::cast(std::move(f));
+  };
+  const py::object bfile = file_object(lb, bodies_path, lb->mapped_bytes());
+  const py::object cfile = file_object(lc, contacts_path, lc->mapped_bytes());
+  const MappedFile& bm = bfile.cast<const MappedFile&>();
+  const MappedFile& cm = cfile.cast<const MappedFile&>();
+
+  const BodyColumns<T>& bc = lb->columns();
+  const std::size_t n = bc.count;
+  // The inverses the solver takes are computed; q and p stay in the file;
+  // v and w are copied, since a solve writes them.
+  py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
+  py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
+  {
+    T* im = data<T>(inv_mass);
+    T* ii = data<T>(inv_inertia);
+    py::gil_scoped_release release;
+    const T inf = std::numeric_limits<T>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool immovable = bc.column[0][i] == inf;
+      im[i] = immovable ? T(0) : T(1) / bc.column[0][i];
+      for (std::size_t k = 0; k < 3; ++k) {
+        const T x = bc.column[1 + k][i];
+        ii[k * n + i] = immovable || x == inf ? T(0) : T(1) / x;
+      }
+    }
+  }
+  const auto cols = [&bc](std::size_t first, std::size_t count) {
+    return std::vector<const T*>(bc.column.begin() + first, bc.column.begin() + first + count);
+  };
+  const auto copy = [&](std::size_t first) {
+    return copy_rows<T>(d, {bc.column[first], bc.column[first + 1], bc.column[first + 2]}, n);
+  };
+  py::object bodies = py::cast(Bodies(inv_mass, inv_inertia, columns_array<T>(d, cols(4, 4), n, bfile, bm),
+                                      columns_array<T>(d, cols(8, 3), n, bfile, bm), copy(11), copy(14)));
+
+  const ContactView<T>& v = lc->view();
+  const std::size_t m = v.count;
+  const auto index_array = [&](const BodyIndex* ids) -> py::array {
+    const auto a = reinterpret_cast<std::uintptr_t>(ids);
+    if (cm.size != 0 && m != 0 && a >= cm.address && a + m * sizeof(BodyIndex) <= cm.address + cm.size) {
+      py::array r(py::dtype::of<std::uint32_t>(), {static_cast<py::ssize_t>(m)}, {}, ids, cfile);
+      py::detail::array_proxy(r.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+      return r;
+    }
+    py::array_t<std::uint32_t> r(static_cast<py::ssize_t>(m));
+    std::copy(ids, ids + m, r.mutable_data());
+    return r;
+  };
+  py::object mu = v.mu ? py::object(columns_array<T>(d, {v.mu}, m, cfile, cm)) : py::none();
+  py::object contacts = py::cast(Contacts(
+      index_array(v.a), index_array(v.b), columns_array<T>(d, {v.c.x, v.c.y, v.c.z}, m, cfile, cm),
+      columns_array<T>(d, {v.n.x, v.n.y, v.n.z}, m, cfile, cm), columns_array<T>(d, {v.e}, m, cfile, cm), 1.0, mu));
+  return py::make_tuple(bodies, contacts);
+}
+
+py::tuple load_py(const std::string& bodies_path, const std::string& contacts_path, const py::object& dtype_in) {
+  Dtype d = Dtype::f64;
+  if (!dtype_in.is_none()) {
+    d = parse_dtype(dtype_in);
+  } else if (scene_format_of(bodies_path) == SceneFormat::npz) {
+    // A binary scene in its own precision: mapped, not converted.
+    try {
+      d = npz_scene_precision(NpzArchive::map(bodies_path)) == NpyType::f4 ? Dtype::f32 : Dtype::f64;
+    } catch (const SceneError& e) {
+      raise_scene_error(e);
+    }
+  }
+  return d == Dtype::f32 ? load_t<float>(bodies_path, contacts_path, d) : load_t<double>(bodies_path, contacts_path, d);
+}
+
 template <class T>
 void write_scene_t(const std::string& bodies_csv, const std::string& contacts_csv, const Bodies& bodies,
                    const Contacts& contacts) {
@@ -1030,8 +1180,8 @@ void write_scene_t(const std::string& bodies_csv, const std::string& contacts_cs
     // memory at a time.
     const BodyTable<T> table = to_body_table(const_view(bv));
     OutputFile ob(bodies_csv), oc(contacts_csv);
-    write_body_table(ob, table);
-    write_contacts(oc, cv);
+    write_body_table(ob, scene_format_of(bodies_csv), columns_of(table));
+    write_contacts(oc, scene_format_of(contacts_csv), cv);
     ob.commit();
     oc.commit();
     return 0;
@@ -1074,17 +1224,17 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
   auto run = [&](auto tag) {
     using T = decltype(tag);
     BodyBuffer<T> buffer(n);
-    const T *pm = data<T>(m), *pI = data<T>(I), *pq = data<T>(q), *pp = data<T>(p), *pv = data<T>(v), *pw = data<T>(w);
+    const T* pm = data<T>(m);
     for (std::size_t i = 0; i < n; ++i) {
       BodyRecord<T> r;
       r.m = pm[i];
       for (int k = 0; k < 3; ++k) {
-        r.I[k] = pI[k * n + i];
-        r.p[k] = pp[k * n + i];
-        r.v[k] = pv[k * n + i];
-        r.w[k] = pw[k * n + i];
+        r.I[k] = row<T>(I, k)[i];
+        r.p[k] = row<T>(p, k)[i];
+        r.v[k] = row<T>(v, k)[i];
+        r.w[k] = row<T>(w, k)[i];
       }
-      for (int k = 0; k < 4; ++k) r.q[k] = pq[k * n + i];
+      for (int k = 0; k < 4; ++k) r.q[k] = row<T>(q, k)[i];
       if (const std::optional<Defect> defect = body_defect(r)) {
         throw py::value_error(owner + ": body " + std::to_string(i) + ", column '" + std::string(defect->column) +
                               "': " + defect->reason);
@@ -1325,6 +1475,12 @@ PYBIND11_MODULE(_collide, m) {
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
         py::arg("model") = "rigid", py::arg("friction") = false, py::arg("dtype") = py::none());
+  py::class_<MappedFile>(m, "MappedFile",
+                         "A scene file mapped into memory: the base of the arrays collide.load() leaves in it.")
+      .def_readonly("path", &MappedFile::path)
+      .def_readonly("address", &MappedFile::address)
+      .def_readonly("size", &MappedFile::size);
+  m.def("load", &load_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("dtype") = py::none());
   m.def("read_scene", &read_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::kw_only(), py::arg("dtype"));
   m.def("write_scene", &write_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::arg("bodies"),
         py::arg("contacts"));

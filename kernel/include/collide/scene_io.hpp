@@ -106,6 +106,40 @@ struct BodyTable {
   void push_back(const BodyRecord<T>& body);
 };
 
+/// The seventeen columns of a bodies file wherever they are held (a
+/// BodyTable, a mapped binary file): column[k] points at `count` values of
+/// column kBodyColumns[k], in physical units as written.
+template <class T>
+struct BodyColumns {
+  std::size_t count = 0;
+  std::array<const T*, kBodyColumns.size()> column{};
+
+  [[nodiscard]] std::size_t size() const { return count; }
+
+  /// Body i in physical units, as written.
+  [[nodiscard]] BodyRecord<T> record(std::size_t i) const {
+    BodyRecord<T> r;
+    r.m = column[0][i];
+    for (int k = 0; k < 3; ++k) r.I[k] = column[1 + k][i];
+    for (int k = 0; k < 4; ++k) r.q[k] = column[4 + k][i];
+    for (int k = 0; k < 3; ++k) {
+      r.p[k] = column[8 + k][i];
+      r.v[k] = column[11 + k][i];
+      r.w[k] = column[14 + k][i];
+    }
+    return r;
+  }
+};
+
+/// A table's columns as BodyColumns (valid while the table lives unchanged).
+template <class T>
+BodyColumns<T> columns_of(const BodyTable<T>& table) {
+  BodyColumns<T> c;
+  c.count = table.size();
+  for (std::size_t k = 0; k < c.column.size(); ++k) c.column[k] = table.column[k].data();
+  return c;
+}
+
 // ---------------------------------------------------------------------------
 // Reading. All readers throw SceneError on the first bad input in file order.
 // ---------------------------------------------------------------------------
@@ -121,7 +155,11 @@ BodyTable<T> read_bodies(const std::string& path);
 /// through BodyBuffer::set (std::invalid_argument for a body that breaks a
 /// rule; a table from parse_bodies has none).
 template <class T>
-BodyBuffer<T> to_body_buffer(const BodyTable<T>& table);
+BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table);
+template <class T>
+BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
+  return to_body_buffer(columns_of(table));
+}
 /// The other way: a kernel view in physical units (1/x, inf for 0), what
 /// write_body_table writes as a scene file.
 template <class T>
@@ -145,13 +183,21 @@ std::string read_file(const std::string& path);
 /// Writes the result bodies file: every column of `inputs` except v and w,
 /// which come from `solved` (same body count). Use std::as_const(buffer).view().
 template <class T>
-void write_bodies(OutputFile& out, const BodyTable<T>& inputs, const BodyView<const T>& solved);
+void write_bodies(OutputFile& out, const BodyColumns<T>& inputs, const BodyView<const T>& solved);
+template <class T>
+void write_bodies(OutputFile& out, const BodyTable<T>& inputs, const BodyView<const T>& solved) {
+  write_bodies(out, columns_of(inputs), solved);
+}
 /// Writes the impulses file (header jx,jy,jz).
 template <class T>
 void write_impulses(OutputFile& out, const ImpulseView<const T>& impulses);
 /// Writes a body table as it is (a scene input file).
 template <class T>
-void write_body_table(OutputFile& out, const BodyTable<T>& table);
+void write_body_table(OutputFile& out, const BodyColumns<T>& table);
+template <class T>
+void write_body_table(OutputFile& out, const BodyTable<T>& table) {
+  write_body_table(out, columns_of(table));
+}
 /// Writes contacts as a contacts file (a scene input file), values as given;
 /// a view without e gets uniform_e in every row, one without mu gets 0.
 template <class T>
@@ -159,11 +205,19 @@ void write_contacts(OutputFile& out, const ContactView<T>& contacts);
 
 /// In-memory forms of the writers above: the complete file text.
 template <class T>
-std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved);
+std::string format_bodies(const BodyColumns<T>& inputs, const BodyView<const T>& solved);
+template <class T>
+std::string format_bodies(const BodyTable<T>& inputs, const BodyView<const T>& solved) {
+  return format_bodies(columns_of(inputs), solved);
+}
 template <class T>
 std::string format_impulses(const ImpulseView<const T>& impulses);
 template <class T>
-std::string format_body_table(const BodyTable<T>& table);
+std::string format_body_table(const BodyColumns<T>& table);
+template <class T>
+std::string format_body_table(const BodyTable<T>& table) {
+  return format_body_table(columns_of(table));
+}
 template <class T>
 std::string format_contacts(const ContactView<T>& contacts);
 

@@ -1,0 +1,206 @@
+// test_cli_npz.cpp - the binary scene files (.npz) through the `collide`
+// executable: gen, solve and convert, exactness both ways, the same results
+// as from CSV, and bad files refused with nothing written.
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "collide/npz.hpp"
+#include "collide/scene_io.hpp"
+#include "support/run_cli.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using collide::NpyType;
+using collide::NpzColumn;
+using collide::test::RunResult;
+using collide::test::slurp;
+
+void spit(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+class CliNpzTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::path(COLLIDE_TEST_TMP) / (std::string("npz_") + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  [[nodiscard]] fs::path path(const std::string& name) const { return dir_ / name; }
+  RunResult run(const std::vector<std::string>& args) const {
+    return collide::test::run_program(COLLIDE_CLI_PATH, dir_, args);
+  }
+  RunResult solve(const std::string& bodies, const std::string& contacts, const std::string& out_bodies,
+                  const std::string& out_impulses, std::vector<std::string> extra = {}) const {
+    std::vector<std::string> args = {"solve",
+                                     "--bodies",
+                                     path(bodies).string(),
+                                     "--contacts",
+                                     path(contacts).string(),
+                                     "--out-bodies",
+                                     path(out_bodies).string(),
+                                     "--out-impulses",
+                                     path(out_impulses).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run(args);
+  }
+  fs::path dir_;
+};
+
+/// Two bodies and one contact as binary files, in double, with one value
+/// replaced by the caller.
+struct SmallScene {
+  std::vector<double> body[17];
+  std::vector<std::uint32_t> a{0}, b{1};
+  std::vector<double> contact[8];  // cx cy cz nx ny nz e mu
+
+  SmallScene() {
+    const double rows[2][17] = {{2, 0.8, 0.8, 0.8, 1, 0, 0, 0, 0, 1, 0, 0.5, -3, 0, 0, 0, 1},
+                                {1.5, 0.2, 0.6, 0.6, 1, 0, 0, 0, 0.8, 2.2, 0, -0.5, 4, 0, 0, 0, -2}};
+    for (int k = 0; k < 17; ++k) body[k] = {rows[0][k], rows[1][k]};
+    const double c[8] = {0.4, 1.6, 0, 0, 1, 0, 0.5, 0.3};
+    for (int k = 0; k < 8; ++k) contact[k] = {c[k]};
+  }
+  [[nodiscard]] std::string bodies_bytes() const {
+    std::vector<NpzColumn> cols;
+    for (int k = 0; k < 17; ++k) cols.push_back({collide::kBodyColumns[k], NpyType::f8, body[k].data(), 2});
+    return collide::format_npz(cols);
+  }
+  [[nodiscard]] std::string contacts_bytes() const {
+    std::vector<NpzColumn> cols = {{"a", NpyType::u4, a.data(), a.size()}, {"b", NpyType::u4, b.data(), b.size()}};
+    for (int k = 0; k < 8; ++k) cols.push_back({collide::kContactColumns[k + 2], NpyType::f8, contact[k].data(), 1});
+    return collide::format_npz(cols);
+  }
+};
+
+TEST_F(CliNpzTest, GenNpzSolvesToTheCsvScenesResults) {
+  // The same draws in both formats; double, so the binary values are the
+  // CSV's exactly and both solves give the same bits.
+  for (const char* kind : {"--pairs", "--debris"}) {
+    ASSERT_EQ(run({"gen", kind, "3000", "--out", path("csv").string(), "--seed", "5", "--friction"}).exit_code, 0);
+    const RunResult g =
+        run({"gen", kind, "3000", "--out", path("bin").string(), "--seed", "5", "--friction", "--format", "npz"});
+    ASSERT_EQ(g.exit_code, 0) << g.err;
+    ASSERT_TRUE(fs::exists(path("bin/bodies.npz")));
+    ASSERT_EQ(solve("csv/bodies.csv", "csv/contacts.csv", "ob.csv", "oj.csv").exit_code, 0);
+    const RunResult r = solve("bin/bodies.npz", "bin/contacts.npz", "ob.npz", "oj.npz", {"--check", "--stats"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("\"check_passed\": true"), std::string::npos) << r.err;
+    // The binary results as CSV are the CSV run's files, byte for byte.
+    ASSERT_EQ(run({"convert", "--in", path("ob.npz").string(), "--out", path("ob2.csv").string()}).exit_code, 0);
+    EXPECT_EQ(slurp(path("ob2.csv")), slurp(path("ob.csv"))) << kind;
+    // Mixed: binary in, CSV out.
+    ASSERT_EQ(solve("bin/bodies.npz", "bin/contacts.npz", "ob3.csv", "oj3.csv").exit_code, 0);
+    EXPECT_EQ(slurp(path("ob3.csv")), slurp(path("ob.csv"))) << kind;
+    EXPECT_EQ(slurp(path("oj3.csv")), slurp(path("oj.csv"))) << kind;
+  }
+}
+
+TEST_F(CliNpzTest, FloatSceneSolvesInItsOwnPrecision) {
+  ASSERT_EQ(
+      run({"gen", "--pairs", "2000", "--out", dir_.string(), "--format", "npz", "--precision", "float"}).exit_code, 0);
+  const RunResult r = solve("bodies.npz", "contacts.npz", "ob.npz", "oj.npz", {"--stats", "--check"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("\"precision\": \"float\""), std::string::npos) << r.err;
+  const RunResult d = solve("bodies.npz", "contacts.npz", "ob.npz", "oj.npz", {"--stats", "--precision", "double"});
+  ASSERT_EQ(d.exit_code, 0) << d.err;
+  EXPECT_NE(d.err.find("\"precision\": \"double\""), std::string::npos) << d.err;
+}
+
+TEST_F(CliNpzTest, ConvertIsExactBothWays) {
+  for (const char* precision : {"float", "double"}) {
+    ASSERT_EQ(run({"gen", "--debris", "5000", "--out", dir_.string(), "--format", "npz", "--precision", precision,
+                   "--friction"})
+                  .exit_code,
+              0);
+    for (const char* table : {"bodies", "contacts"}) {
+      const std::string npz = path(std::string(table) + ".npz").string();
+      const std::string csv = path(std::string(table) + ".csv").string();
+      const std::string back = path(std::string(table) + "_back.npz").string();
+      const std::string csv2 = path(std::string(table) + "_2.csv").string();
+      ASSERT_EQ(run({"convert", "--in", npz, "--out", csv}).exit_code, 0);
+      // Binary -> CSV -> binary: the same bytes.
+      const RunResult r = run({"convert", "--in", csv, "--out", back, "--precision", precision});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_EQ(slurp(back), slurp(npz)) << precision << " " << table;
+      // CSV -> binary -> CSV: the same text.
+      ASSERT_EQ(run({"convert", "--in", back, "--out", csv2}).exit_code, 0);
+      EXPECT_EQ(slurp(csv2), slurp(csv)) << precision << " " << table;
+    }
+  }
+}
+
+TEST_F(CliNpzTest, BadValueNamesFileRowAndColumnAndWritesNothing) {
+  SmallScene s;
+  s.body[0][1] = -1;  // m of body 1
+  spit(path("b.npz"), s.bodies_bytes());
+  spit(path("c.npz"), SmallScene().contacts_bytes());
+  const RunResult r = solve("b.npz", "c.npz", "ob.npz", "oj.npz");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("b.npz: row 1, column 'm': mass must be > 0, got -1"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("ob.npz")));
+  EXPECT_FALSE(fs::exists(path("oj.npz")));
+}
+
+TEST_F(CliNpzTest, BadContactsNamed) {
+  spit(path("b.npz"), SmallScene().bodies_bytes());
+  {
+    SmallScene s;
+    s.b[0] = 7;
+    spit(path("c.npz"), s.contacts_bytes());
+    const RunResult r = solve("b.npz", "c.npz", "ob.npz", "oj.npz");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("c.npz: row 0, column 'b': body id 7 is out of range"), std::string::npos) << r.err;
+  }
+  {
+    SmallScene s;
+    s.contact[3] = {0.5};  // |n| = 0.5
+    spit(path("c.npz"), s.contacts_bytes());
+    const RunResult r = solve("b.npz", "c.npz", "ob.npz", "oj.npz");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("c.npz: row 0, column 'nx'"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(path("ob.npz")));
+}
+
+TEST_F(CliNpzTest, MalformedArchiveIsRefused) {
+  spit(path("b.npz"), "PK\x03\x04 not really a zip archive");
+  spit(path("c.npz"), SmallScene().contacts_bytes());
+  const RunResult r = solve("b.npz", "c.npz", "ob.npz", "oj.npz");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("collide: "), std::string::npos);
+  EXPECT_NE(r.err.find("b.npz"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("ob.npz")));
+}
+
+TEST_F(CliNpzTest, FormatOptionOverridesTheName) {
+  spit(path("b.bin"), SmallScene().bodies_bytes());
+  spit(path("c.bin"), SmallScene().contacts_bytes());
+  const RunResult r = solve("b.bin", "c.bin", "ob.bin", "oj.bin", {"--format", "npz"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(path("oj.bin")).substr(0, 2), "PK");
+  const RunResult bad = solve("b.bin", "c.bin", "ob.bin", "oj.bin", {"--format", "hdf5"});
+  EXPECT_EQ(bad.exit_code, 2);
+}
+
+TEST_F(CliNpzTest, ConvertRefusesWhatIsNotATable) {
+  spit(path("x.csv"), "p,q\n1,2\n");
+  const RunResult r = run({"convert", "--in", path("x.csv").string(), "--out", path("x.npz").string()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("x.csv:1"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("x.npz")));
+}
+
+}  // namespace
