@@ -56,7 +56,7 @@ ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE "package|objects"
 
 # --- 2. Fuzzing -------------------------------------------------------------
 stage "fuzzing, ${fuzz_seconds}s per target"
-targets=(scene_io kernel entry)
+targets=(scene_io kernel entry npz)
 pids=()
 for t in "${targets[@]}"; do
   work="$asan/fuzz-work/$t"
