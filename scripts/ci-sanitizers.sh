@@ -11,7 +11,7 @@
 #      install the library and build consumers without sanitizer flags (which
 #      cannot link a sanitized archive) and recompile the library, and the
 #      Release stage has run them already.
-#   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 60),
+#   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 45),
 #      the targets side by side on the available cores, from a scratch copy of
 #      fuzz/corpus/<target>/ (the committed seeds stay as they are). A crash,
 #      UB, a leak, an input over 10 s (-timeout) or over 2 GB (-rss_limit_mb)
@@ -31,7 +31,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install-deps.sh"
 
 jobs="$(nproc)"
-fuzz_seconds="${FUZZ_SECONDS:-60}"
+fuzz_seconds="${FUZZ_SECONDS:-45}"
 cxx="$(command -v clang++-14 || command -v clang++)"
 # Through ccache when present, as scripts/build.sh does: a re-run after a
 # change recompiles only what changed.

@@ -226,7 +226,8 @@ const BodyIndex* index_column(const NpzArchive& archive, const NpzMember& m, std
       bool negative = false;
       const std::uint64_t id = read(i, negative);
       if (!negative && id <= std::numeric_limits<BodyIndex>::max()) continue;
-      const std::string text = (negative ? "-" : "") + std::to_string(id);
+      std::string text = std::to_string(id);
+      if (negative) text.insert(text.begin(), '-');
       const std::string reason =
           negative ? "body id must be a non-negative integer, got " + text : body_id_out_of_range(text, body_count);
       throw SceneError(archive.file_name(), 0, i, m.name, reason);
