@@ -63,6 +63,7 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include "collide/scene_io.hpp"
+#include "input_file.hpp"
 
 namespace collide {
 
@@ -607,21 +608,8 @@ NpzArchive NpzArchive::parse(std::string_view bytes, std::string file_name) {
 }
 
 NpzArchive NpzArchive::map(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    const int err = errno;
-    throw SceneError(path, std::string("cannot open: ") + std::strerror(err), err);
-  }
-  struct FdCloser {
-    int fd;
-    ~FdCloser() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    const int err = errno;
-    throw SceneError(path, std::string("cannot stat: ") + std::strerror(err), err);
-  }
-  if (S_ISDIR(st.st_mode)) throw SceneError(path, "cannot read: is a directory", EISDIR);
+  const detail::InputFile file(path);
+  const int fd = file.fd();
 
   // The mapping is owned by a guard until parse() has accepted the bytes, so
   // a refused archive is unmapped on the way out.
@@ -633,8 +621,8 @@ NpzArchive NpzArchive::map(const std::string& path) {
     }
   } mapping;
   std::size_t length = 0;
-  if (S_ISREG(st.st_mode)) {
-    length = static_cast<std::size_t>(st.st_size);
+  if (file.regular()) {
+    length = file.size();
     if (length == 0) throw SceneError(path, "empty file, not an .npz archive");
     // No MAP_POPULATE or MADV_WILLNEED: only the directory and the .npy
     // headers are read here; the data is streamed by whoever uses it.

@@ -31,6 +31,7 @@
 #include "collide/scene_io.hpp"
 
 #include "body_fill.hpp"
+#include "input_file.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -152,23 +153,10 @@ class FileBuffer {
   }
 
   explicit FileBuffer(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) {
-      const int err = errno;
-      throw SceneError(path, std::string("cannot open: ") + std::strerror(err), err);
-    }
-    struct FdCloser {
-      int fd;
-      ~FdCloser() { ::close(fd); }
-    } closer{fd};
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) {
-      const int err = errno;
-      throw SceneError(path, std::string("cannot stat: ") + std::strerror(err), err);
-    }
-    if (S_ISDIR(st.st_mode)) throw SceneError(path, "cannot read: is a directory", EISDIR);
-    if (S_ISREG(st.st_mode) && st.st_size > 0) {
-      size_ = static_cast<std::size_t>(st.st_size);
+    const detail::InputFile file(path);
+    const int fd = file.fd();
+    if (file.regular() && file.size() > 0) {
+      size_ = file.size();
       void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
       if (p != MAP_FAILED) {
         mapped_ = p;
