@@ -17,11 +17,9 @@
 // * The output goes through OutputFile: nothing is written on bad input.
 #include <cstdio>
 #include <fstream>
-#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
-
-#include <oneapi/tbb/global_control.h>
 
 #include "collide/npz.hpp"
 #include "collide/rules.hpp"
@@ -52,12 +50,21 @@ namespace {
 
 enum class Table { bodies, contacts };
 
-Table table_of(const std::string& path, SceneFormat format) {
+/// The table a file holds, and a binary file's own precision.
+struct TableFile {
+  Table table;
+  std::optional<Precision> precision;
+};
+
+TableFile table_of(const std::string& path, SceneFormat format) {
   if (format == SceneFormat::npz) {
     const NpzArchive archive = NpzArchive::map(path);
-    if (archive.find("m") != nullptr) return Table::bodies;
-    if (archive.find("a") != nullptr) return Table::contacts;
-    throw SceneError(path, "neither a bodies file (member 'm.npy') nor a contacts file (member 'a.npy')");
+    const bool bodies = archive.find("m") != nullptr;
+    if (!bodies && archive.find("a") == nullptr) {
+      throw SceneError(path, "neither a bodies file (member 'm.npy') nor a contacts file (member 'a.npy')");
+    }
+    return {bodies ? Table::bodies : Table::contacts,
+            npz_scene_precision(archive) == NpyType::f4 ? Precision::single : Precision::double_};
   }
   std::ifstream file(path, std::ios::binary);
   std::string first;
@@ -68,8 +75,8 @@ Table table_of(const std::string& path, SceneFormat format) {
     while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.remove_suffix(1);
     return line == header.substr(0, header.size() - 1);
   };
-  if (same_header(bodies_header())) return Table::bodies;
-  if (same_header(contacts_header())) return Table::contacts;
+  if (same_header(bodies_header())) return {Table::bodies, std::nullopt};
+  if (same_header(contacts_header())) return {Table::contacts, std::nullopt};
   throw SceneError(path, 1, SceneError::kNoRow, "",
                    "neither a bodies header (" + std::string(bodies_header().substr(0, bodies_header().size() - 1)) +
                        ") nor a contacts header (" +
@@ -103,30 +110,14 @@ int run_convert(int argc, char** argv) {
   const std::string& out = required(opt, "out");
   const SceneFormat in_format = scene_format_of(in);
   const SceneFormat out_format = scene_format_of(out);
-  bool want_float = false;
-  if (const auto it = opt.find("precision"); it != opt.end()) {
-    if (it->second != "float" && it->second != "double") {
-      throw UsageError("--precision must be float or double, got '" + it->second + "'");
-    }
-    want_float = it->second == "float";
-  }
-  std::unique_ptr<oneapi::tbb::global_control> limit;
-  if (const auto it = opt.find("threads"); it != opt.end()) {
-    const unsigned long long threads = parse_count("threads", it->second);
-    if (threads > 4096) throw UsageError("--threads " + it->second + " is too many");
-    if (threads > 0) {
-      limit = std::make_unique<oneapi::tbb::global_control>(oneapi::tbb::global_control::max_allowed_parallelism,
-                                                            static_cast<std::size_t>(threads));
-    }
-  }
-  const Table table = table_of(in, in_format);
-  if (in_format == SceneFormat::npz && opt.count("precision") == 0) {
-    want_float = npz_scene_precision(NpzArchive::map(in)) == NpyType::f4;
-  }
-  if (want_float) {
-    convert<float>(in, in_format, table, out, out_format);
+  const std::optional<Precision> precision = parse_precision(opt);
+  const ThreadLimit limit(parse_threads(opt));
+  const TableFile table = table_of(in, in_format);
+  const Precision chosen = precision.value_or(table.precision.value_or(Precision::double_));
+  if (chosen == Precision::single) {
+    convert<float>(in, in_format, table.table, out, out_format);
   } else {
-    convert<double>(in, in_format, table, out, out_format);
+    convert<double>(in, in_format, table.table, out, out_format);
   }
   return kExitOk;
 }

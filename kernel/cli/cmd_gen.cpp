@@ -25,14 +25,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_pipeline.h>
 #include <oneapi/tbb/task_arena.h>
@@ -303,23 +301,12 @@ int run_gen(int argc, char** argv) {
       throw UsageError(std::string("--format: ") + e.what());
     }
   }
-  bool want_float = false;
-  if (const auto it = opt.find("precision"); it != opt.end()) {
-    if (it->second != "float" && it->second != "double") {
-      throw UsageError("--precision must be float or double, got '" + it->second + "'");
-    }
-    if (format != SceneFormat::npz) throw UsageError("--precision is for --format npz (CSV text is the double's)");
-    want_float = it->second == "float";
+  const std::optional<Precision> precision = parse_precision(opt);
+  if (precision && format != SceneFormat::npz) {
+    throw UsageError("--precision is for --format npz (CSV text is the double's)");
   }
-  std::unique_ptr<oneapi::tbb::global_control> limit;
-  if (const auto it = opt.find("threads"); it != opt.end()) {
-    const unsigned long long threads = parse_count("threads", it->second);
-    if (threads > 4096) throw UsageError("--threads " + it->second + " is too many");
-    if (threads > 0) {
-      limit = std::make_unique<oneapi::tbb::global_control>(oneapi::tbb::global_control::max_allowed_parallelism,
-                                                            static_cast<std::size_t>(threads));
-    }
-  }
+  const bool want_float = precision == Precision::single;
+  const ThreadLimit limit(parse_threads(opt));
 
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);

@@ -39,14 +39,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
-
-#include <oneapi/tbb/global_control.h>
 
 #include "collide/check.hpp"
 #include "collide/error_bound.hpp"
@@ -294,11 +291,8 @@ int run_solve(int argc, char** argv) {
     req.out_bodies_format = scene_format_of(req.out_bodies_path);
     req.out_impulses_format = scene_format_of(req.out_impulses_path);
   }
-  if (const auto it = opt.find("precision"); it != opt.end()) {
-    if (it->second != "float" && it->second != "double") {
-      throw UsageError("--precision must be float or double, got '" + it->second + "'");
-    }
-    req.want_float = it->second == "float";
+  if (const std::optional<Precision> precision = parse_precision(opt)) {
+    req.want_float = *precision == Precision::single;
   } else if (req.bodies_format == SceneFormat::npz) {
     // A binary scene runs in its own precision; a bad file is reported (exit
     // 1) when it is read.
@@ -307,11 +301,7 @@ int run_solve(int argc, char** argv) {
     } catch (const SceneError&) {
     }
   }
-  if (const auto it = opt.find("threads"); it != opt.end()) {
-    const unsigned long long n = parse_count("threads", it->second);
-    if (n > 4096) throw UsageError("--threads " + it->second + " is too many");
-    req.threads = static_cast<int>(n);
-  }
+  req.threads = parse_threads(opt);
   if (const auto it = opt.find("path"); it != opt.end()) {
     if (it->second != "simd" && it->second != "scalar") {
       throw UsageError("--path must be simd or scalar, got '" + it->second + "'");
@@ -362,11 +352,7 @@ int run_solve(int argc, char** argv) {
   req.stats = opt.count("stats") != 0;
   req.check = opt.count("check") != 0;
 
-  std::unique_ptr<oneapi::tbb::global_control> limit;
-  if (req.threads > 0) {
-    limit = std::make_unique<oneapi::tbb::global_control>(oneapi::tbb::global_control::max_allowed_parallelism,
-                                                          static_cast<std::size_t>(req.threads));
-  }
+  const ThreadLimit limit(req.threads);
   return req.want_float ? solve_scene<float>(req) : solve_scene<double>(req);
 }
 

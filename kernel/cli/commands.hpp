@@ -11,6 +11,8 @@
 #pragma once
 
 #include <map>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -43,6 +45,27 @@ Options parse_options(int argc, char** argv, int first, const std::vector<Option
 const std::string& required(const Options& options, const std::string& name);
 /// Parses a non-negative decimal integer option value. Throws UsageError.
 unsigned long long parse_count(const std::string& name, const std::string& value);
+
+/// The precision a scene is read, solved or written in.
+enum class Precision { single, double_ };
+/// --precision float|double, or nothing when it is not given.
+std::optional<Precision> parse_precision(const Options& options);
+/// --threads N: worker threads, 0 (the default) for all; at most 4096.
+int parse_threads(const Options& options);
+
+/// Caps TBB's threads for the rest of a command while it lives (also the
+/// threads of parsing and writing); no cap for 0.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  struct Control;
+  std::unique_ptr<Control> control_;
+};
 
 int run_solve(int argc, char** argv);
 int run_gen(int argc, char** argv);

@@ -10,6 +10,8 @@
 #include <string>
 #include <string_view>
 
+#include <oneapi/tbb/global_control.h>
+
 #include "commands.hpp"
 
 namespace collide::cli {
@@ -87,6 +89,35 @@ unsigned long long parse_count(const std::string& name, const std::string& value
   }
   return n;
 }
+
+std::optional<Precision> parse_precision(const Options& options) {
+  const auto it = options.find("precision");
+  if (it == options.end()) return std::nullopt;
+  if (it->second == "float") return Precision::single;
+  if (it->second == "double") return Precision::double_;
+  throw UsageError("--precision must be float or double, got '" + it->second + "'");
+}
+
+int parse_threads(const Options& options) {
+  const auto it = options.find("threads");
+  if (it == options.end()) return 0;
+  const unsigned long long n = parse_count("threads", it->second);
+  if (n > 4096) throw UsageError("--threads " + it->second + " is too many");
+  return static_cast<int>(n);
+}
+
+struct ThreadLimit::Control {
+  oneapi::tbb::global_control control;
+};
+
+ThreadLimit::ThreadLimit(int threads) {
+  if (threads > 0) {
+    control_ = std::make_unique<Control>(Control{oneapi::tbb::global_control(
+        oneapi::tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads))});
+  }
+}
+
+ThreadLimit::~ThreadLimit() = default;
 
 }  // namespace collide::cli
 
