@@ -110,6 +110,22 @@ bool all_chunks(std::size_t n, const F& ok) {
       [](bool x, bool y) { return x && y; });
 }
 
+/// The first row i of [0, n) for which ok(i) is false, or n. Screened in
+/// parallel chunks; only a failed screen is scanned again, row by row on
+/// one thread, so the row found does not depend on threads.
+template <class Ok>
+std::size_t first_failing_row(std::size_t n, const Ok& ok) {
+  const bool all = all_chunks(n, [&](std::size_t i0, std::size_t i1) {
+    bool good = true;
+    for (std::size_t i = i0; i < i1; ++i) good &= ok(i);
+    return good;
+  });
+  if (all) return n;
+  std::size_t i = 0;
+  while (i < n && ok(i)) ++i;
+  return i;
+}
+
 template <class From, class T>
 void convert_into(const std::byte* data, std::size_t n, T* out) {
   oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 16),
@@ -153,23 +169,16 @@ const T* real_column(const NpzArchive& archive, const NpzMember& m, NpyType prec
   } else {
     convert_into<double>(m.data, m.count, owned.data());
     if constexpr (std::is_same_v<T, float>) {
-      const auto fits = [&](std::size_t i) {
+      const auto stored = [&](std::size_t i) {
         double x;
         std::memcpy(&x, m.data + i * sizeof(double), sizeof(double));
-        return !std::isfinite(x) || std::isfinite(owned[i]);
+        return x;
       };
-      const bool ok = all_chunks(m.count, [&](std::size_t i0, std::size_t i1) {
-        bool good = true;
-        for (std::size_t i = i0; i < i1; ++i) good &= fits(i);
-        return good;
-      });
-      if (!ok) {
-        for (std::size_t i = 0; i < m.count; ++i) {
-          if (fits(i)) continue;
-          double x;
-          std::memcpy(&x, m.data + i * sizeof(double), sizeof(double));
-          throw SceneError(archive.file_name(), 0, i, m.name, "value " + shortest(x) + " is out of the range of float");
-        }
+      const std::size_t bad = first_failing_row(
+          m.count, [&](std::size_t i) { return !std::isfinite(stored(i)) || std::isfinite(owned[i]); });
+      if (bad < m.count) {
+        throw SceneError(archive.file_name(), 0, bad, m.name,
+                         "value " + shortest(stored(bad)) + " is out of the range of float");
       }
     }
   }
@@ -210,28 +219,19 @@ const BodyIndex* index_column(const NpzArchive& archive, const NpzMember& m, std
     negative = is_signed && static_cast<std::int64_t>(u) < 0;
     return negative ? ~u + 1 : u;
   };
-  const auto fits = [&](std::size_t i) {
+  const std::size_t bad = first_failing_row(m.count, [&](std::size_t i) {
     bool negative = false;
     const std::uint64_t id = read(i, negative);
     owned[i] = static_cast<BodyIndex>(id);
     return !negative && id <= std::numeric_limits<BodyIndex>::max();
-  };
-  const bool ok = all_chunks(m.count, [&](std::size_t i0, std::size_t i1) {
-    bool good = true;
-    for (std::size_t i = i0; i < i1; ++i) good &= fits(i);
-    return good;
   });
-  if (!ok) {
-    for (std::size_t i = 0; i < m.count; ++i) {
-      bool negative = false;
-      const std::uint64_t id = read(i, negative);
-      if (!negative && id <= std::numeric_limits<BodyIndex>::max()) continue;
-      std::string text = std::to_string(id);
-      if (negative) text.insert(text.begin(), '-');
-      const std::string reason =
-          negative ? "body id must be a non-negative integer, got " + text : body_id_out_of_range(text, body_count);
-      throw SceneError(archive.file_name(), 0, i, m.name, reason);
-    }
+  if (bad < m.count) {
+    bool negative = false;
+    std::string text = std::to_string(read(bad, negative));
+    if (negative) text.insert(text.begin(), '-');
+    const std::string reason =
+        negative ? "body id must be a non-negative integer, got " + text : body_id_out_of_range(text, body_count);
+    throw SceneError(archive.file_name(), 0, bad, m.name, reason);
   }
   return owned.data();
 }
@@ -274,17 +274,10 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
     out.mapped_ |= in_place;
   }
   const BodyColumns<T>& columns = out.columns_;
-  const bool ok = all_chunks(n, [&](std::size_t i0, std::size_t i1) {
-    bool good = true;
-    for (std::size_t i = i0; i < i1; ++i) good &= body_ok(columns.record(i));
-    return good;
-  });
-  if (!ok) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (const auto defect = body_defect(columns.record(i))) {
-        throw SceneError(archive.file_name(), 0, i, std::string(defect->column), defect->reason);
-      }
-    }
+  const std::size_t bad = first_failing_row(n, [&](std::size_t i) { return body_ok(columns.record(i)); });
+  if (bad < n) {
+    const auto defect = body_defect(columns.record(bad));  // body_ok's verdict, with its reason
+    throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
   }
   return out;
 }
@@ -339,25 +332,14 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
     r.mu = v.mu[i];
     return r;
   };
-  const bool ok = all_chunks(n, [&](std::size_t i0, std::size_t i1) {
-    bool good = true;
-    for (std::size_t i = i0; i < i1; ++i) good &= contact_ok(record(i), body_count);
-    return good;
-  });
-  if (!ok) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (const auto defect = contact_defect(record(i), body_count)) {
-        throw SceneError(archive.file_name(), 0, i, std::string(defect->column), defect->reason);
-      }
-    }
+  const std::size_t bad = first_failing_row(n, [&](std::size_t i) { return contact_ok(record(i), body_count); });
+  if (bad < n) {
+    const auto defect = contact_defect(record(bad), body_count);  // contact_ok's verdict, with its reason
+    throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
   }
   // As ContactBuffer::view(): a scene without friction runs the frictionless
   // kernel.
-  const bool friction = !all_chunks(n, [&](std::size_t i0, std::size_t i1) {
-    bool none = true;
-    for (std::size_t i = i0; i < i1; ++i) none &= v.mu[i] == T(0);
-    return none;
-  });
+  const bool friction = first_failing_row(n, [&](std::size_t i) { return v.mu[i] == T(0); }) < n;
   if (!friction) v.mu = nullptr;
   out.view_ = v;
   return out;
