@@ -588,26 +588,35 @@ BodyBuffer<T> detail::fill_body_buffer(const BodyColumns<T>& table) {
   using Range = oneapi::tbb::blocked_range<std::size_t>;
   BodyBuffer<T> bodies(table.size());
   // Column by column: q, p, v and w are copied as they are, m and I
-  // inverted as BodyBuffer::set inverts them (1/inf = 0; an immovable body
-  // has no inverse moments). Disjoint row ranges, so threads never share an
+  // inverted (inverses_of). Disjoint row ranges, so threads never share an
   // element.
   BodyView<T> v = bodies.view();
   T* const copied[13] = {v.q.w, v.q.x, v.q.y, v.q.z, v.p.x, v.p.y, v.p.z, v.v.x, v.v.y, v.v.z, v.w.x, v.w.y, v.w.z};
   oneapi::tbb::parallel_for(Range(0, table.size(), 1 << 16), [&](const Range& r) {
     const std::size_t i0 = r.begin(), n = r.size();
     for (std::size_t k = 0; k < 13; ++k) std::memcpy(copied[k] + i0, table.column[4 + k] + i0, n * sizeof(T));
+  });
+  inverses_of(table, v.inv_mass, v.inv_inertia);
+  return bodies;
+}
+
+template <class T>
+void inverses_of(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>& inv_inertia) {
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
+  // As BodyBuffer::set: 1/inf = 0, and an immovable body has no inverse
+  // moments whatever its I (the law).
+  oneapi::tbb::parallel_for(Range(0, columns.count, 1 << 16), [&](const Range& r) {
     const T inf = std::numeric_limits<T>::infinity();
-    for (std::size_t i = i0; i != r.end(); ++i) {
-      const T m = table.column[0][i];
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const T m = columns.column[0][i];
       const bool immovable = m == inf;
-      v.inv_mass[i] = immovable ? T(0) : T(1) / m;
-      const T ix = table.column[1][i], iy = table.column[2][i], iz = table.column[3][i];
-      v.inv_inertia.x[i] = immovable || ix == inf ? T(0) : T(1) / ix;
-      v.inv_inertia.y[i] = immovable || iy == inf ? T(0) : T(1) / iy;
-      v.inv_inertia.z[i] = immovable || iz == inf ? T(0) : T(1) / iz;
+      inv_mass[i] = immovable ? T(0) : T(1) / m;
+      const T ix = columns.column[1][i], iy = columns.column[2][i], iz = columns.column[3][i];
+      inv_inertia.x[i] = immovable || ix == inf ? T(0) : T(1) / ix;
+      inv_inertia.y[i] = immovable || iy == inf ? T(0) : T(1) / iy;
+      inv_inertia.z[i] = immovable || iz == inf ? T(0) : T(1) / iz;
     }
   });
-  return bodies;
 }
 
 template <class T>
@@ -939,6 +948,7 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template BodyTable<T> read_bodies<T>(const std::string&);                                     \
   template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                              \
   template BodyBuffer<T> detail::fill_body_buffer<T>(const BodyColumns<T>&);                    \
+  template void inverses_of<T>(const BodyColumns<T>&, T*, const Vec3Array<T>&);                 \
   template ContactBuffer<T> parse_contacts<T>(std::string_view, std::string_view, std::size_t); \
   template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);                  \
   template void write_bodies<T>(OutputFile&, const BodyColumns<T>&, const BodyView<const T>&);  \

@@ -1110,17 +1110,9 @@ py::tuple load_t(const std::string& bodies_path, const std::string& contacts_pat
   py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
   {
     T* im = data<T>(inv_mass);
-    T* ii = data<T>(inv_inertia);
+    const Vec3Array<T> ii = vec3<T>(inv_inertia);
     py::gil_scoped_release release;
-    const T inf = std::numeric_limits<T>::infinity();
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool immovable = bc.column[0][i] == inf;
-      im[i] = immovable ? T(0) : T(1) / bc.column[0][i];
-      for (std::size_t k = 0; k < 3; ++k) {
-        const T x = bc.column[1 + k][i];
-        ii[k * n + i] = immovable || x == inf ? T(0) : T(1) / x;
-      }
-    }
+    inverses_of(bc, im, ii);
   }
   const auto cols = [&bc](std::size_t first, std::size_t count) {
     return std::vector<const T*>(bc.column.begin() + first, bc.column.begin() + first + count);

@@ -160,6 +160,12 @@ template <class T>
 BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
   return to_body_buffer(columns_of(table));
 }
+/// The inverses the kernels take, from columns that obey the rules:
+/// inv_mass = 1/m and inv_inertia = 1/I, 0 for inf and every inverse
+/// moment of an immovable body 0, as BodyBuffer::set stores them; rows in
+/// parallel. No rule is checked (to_body_buffer checks them).
+template <class T>
+void inverses_of(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>& inv_inertia);
 /// The other way: a kernel view in physical units (1/x, inf for 0), what
 /// write_body_table writes as a scene file.
 template <class T>
