@@ -134,7 +134,7 @@ int solve_scene(const SolveRequest& req) {
   const auto t_read = Clock::now();
   const LoadedBodies<T> table = load_bodies<T>(req.bodies_path, req.bodies_format);
   const LoadedContacts<T> contacts = load_contacts<T>(req.contacts_path, req.contacts_format, table.size());
-  BodyBuffer<T> bodies = table.buffer();
+  SolveBodies<T> bodies(table.columns());
   const double read_seconds = seconds_since(t_read);
 
   // The reference must see the inputs the kernel sees: copy before solving.

@@ -30,7 +30,6 @@
 //   for any thread count.
 #include "collide/scene_io.hpp"
 
-#include "body_fill.hpp"
 #include "input_file.hpp"
 
 #include <fcntl.h>
@@ -580,12 +579,6 @@ BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table) {
     BodyBuffer<T> named(table.size());
     for (std::size_t i = 0; i < table.size(); ++i) named.set(i, table.record(i));  // throws at the first defect
   }
-  return detail::fill_body_buffer(table);
-}
-
-template <class T>
-BodyBuffer<T> detail::fill_body_buffer(const BodyColumns<T>& table) {
-  using Range = oneapi::tbb::blocked_range<std::size_t>;
   BodyBuffer<T> bodies(table.size());
   // Column by column: q, p, v and w are copied as they are, m and I
   // inverted (inverses_of). Disjoint row ranges, so threads never share an
@@ -947,7 +940,6 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template BodyTable<T> parse_bodies<T>(std::string_view, std::string_view);                    \
   template BodyTable<T> read_bodies<T>(const std::string&);                                     \
   template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                              \
-  template BodyBuffer<T> detail::fill_body_buffer<T>(const BodyColumns<T>&);                    \
   template void inverses_of<T>(const BodyColumns<T>&, T*, const Vec3Array<T>&);                 \
   template ContactBuffer<T> parse_contacts<T>(std::string_view, std::string_view, std::size_t); \
   template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);                  \

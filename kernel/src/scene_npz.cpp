@@ -34,8 +34,6 @@
 
 #include "collide/rules.hpp"
 
-#include "body_fill.hpp"
-
 namespace collide {
 
 SceneFormat scene_format_of(std::string_view path) {
@@ -283,8 +281,45 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
 }
 
 template <class T>
-BodyBuffer<T> LoadedBodies<T>::buffer() const {
-  return detail::fill_body_buffer(columns_);
+SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns) : count_(columns.count), own_(new T[10 * columns.count]) {
+  for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
+  BodyView<T> v = view();
+  inverses_of(columns, v.inv_mass, v.inv_inertia);
+  T* const solved[6] = {v.v.x, v.v.y, v.v.z, v.w.x, v.w.y, v.w.z};
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
+  oneapi::tbb::parallel_for(Range(0, count_, std::size_t{1} << 16), [&](const Range& r) {
+    for (std::size_t k = 0; k < 6; ++k) {
+      std::memcpy(solved[k] + r.begin(), columns.column[11 + k] + r.begin(), r.size() * sizeof(T));
+    }
+  });
+}
+
+template <class T>
+BodyView<T> SolveBodies<T>::view() {
+  T* o = own_.get();
+  const std::size_t n = count_;
+  // The kernels read q and p and write only v and w (BodyView): the const
+  // is taken off for the view's type, never for a write.
+  const auto read = [this](std::size_t k) { return const_cast<T*>(read_[k]); };
+  return {n,
+          o,
+          {o + n, o + 2 * n, o + 3 * n},
+          {read(0), read(1), read(2), read(3)},
+          {read(4), read(5), read(6)},
+          {o + 4 * n, o + 5 * n, o + 6 * n},
+          {o + 7 * n, o + 8 * n, o + 9 * n}};
+}
+
+template <class T>
+BodyView<const T> SolveBodies<T>::view() const {
+  const BodyView<T> v = const_cast<SolveBodies*>(this)->view();
+  return {v.count,
+          v.inv_mass,
+          {v.inv_inertia.x, v.inv_inertia.y, v.inv_inertia.z},
+          {v.q.w, v.q.x, v.q.y, v.q.z},
+          {v.p.x, v.p.y, v.p.z},
+          {v.v.x, v.v.y, v.v.z},
+          {v.w.x, v.w.y, v.w.z}};
 }
 
 template <class T>
@@ -428,6 +463,7 @@ void write_contacts(OutputFile& out, SceneFormat format, const ContactView<T>& c
 #define COLLIDE_SCENE_NPZ_INSTANTIATE(T)                                                           \
   template class LoadedBodies<T>;                                                                  \
   template class LoadedContacts<T>;                                                                \
+  template class SolveBodies<T>;                                                                   \
   template LoadedBodies<T> load_bodies<T>(const std::string&, SceneFormat);                        \
   template LoadedContacts<T> load_contacts<T>(const std::string&, SceneFormat, std::size_t);       \
   template void write_bodies_npz<T>(OutputFile&, const BodyColumns<T>&, const BodyView<const T>&); \

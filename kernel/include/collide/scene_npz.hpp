@@ -77,9 +77,6 @@ class LoadedBodies {
   [[nodiscard]] bool mapped() const { return mapped_; }
   /// The mapped file's bytes (empty for CSV): where in-place columns lie.
   [[nodiscard]] std::string_view mapped_bytes() const { return archive_ ? archive_->bytes() : std::string_view(); }
-  /// What the kernels take (1/m, 1/I; q, p, v, w copied), as to_body_buffer
-  /// makes it, without checking the rules again: the loader did.
-  [[nodiscard]] BodyBuffer<T> buffer() const;
 
  private:
   template <class U>
@@ -110,6 +107,28 @@ class LoadedContacts {
   std::unique_ptr<NpzArchive> archive_;  // binary: the mapped file
   ContactView<T> view_;
   bool mapped_ = false;
+};
+
+/// The bodies of a solve over columns that obey the rules (a loaded
+/// file's): q and p are read where the columns hold them (a mapped file's
+/// pages, a table) and never copied; 1/m and 1/I (inverses_of) and v and w,
+/// which the solve writes, live in arrays of its own, allocated without
+/// being cleared first. view() is valid while the columns are. Not
+/// copyable; movable.
+template <class T>
+class SolveBodies {
+ public:
+  explicit SolveBodies(const BodyColumns<T>& columns);
+  /// For the solver: q and p must not be written through it (the kernels
+  /// only read them; a mapped file's pages are read-only).
+  [[nodiscard]] BodyView<T> view();
+  [[nodiscard]] BodyView<const T> view() const;
+  [[nodiscard]] std::size_t size() const { return count_; }
+
+ private:
+  std::size_t count_ = 0;
+  std::unique_ptr<T[]> own_;        // inv_mass, Ix, Iy, Iz, vx, vy, vz, wx, wy, wz: 10 runs of count_
+  std::array<const T*, 7> read_{};  // qw, qx, qy, qz, px, py, pz
 };
 
 /// Reads a bodies file (CSV: read_bodies; binary: mapped and checked).
