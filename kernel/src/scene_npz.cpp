@@ -33,6 +33,7 @@
 #include <utility>
 
 #include "collide/rules.hpp"
+#include "collide/validate.hpp"
 
 namespace collide {
 
@@ -272,7 +273,9 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
     out.mapped_ |= in_place;
   }
   const BodyColumns<T>& columns = out.columns_;
-  const std::size_t bad = first_failing_row(n, [&](std::size_t i) { return body_ok(columns.record(i)); });
+  const bool screened = all_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); });
+  const std::size_t bad =
+      screened ? n : first_failing_row(n, [&](std::size_t i) { return body_ok(columns.record(i)); });
   if (bad < n) {
     const auto defect = body_defect(columns.record(bad));  // body_ok's verdict, with its reason
     throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
@@ -367,7 +370,11 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
     r.mu = v.mu[i];
     return r;
   };
-  const std::size_t bad = first_failing_row(n, [&](std::size_t i) { return contact_ok(record(i), body_count); });
+  // The lane layer's screen first (validate.hpp); only a scene it does not
+  // clear is judged row by row, exactly.
+  const std::size_t bad = contacts_pass_screen(v, body_count)
+                              ? n
+                              : first_failing_row(n, [&](std::size_t i) { return contact_ok(record(i), body_count); });
   if (bad < n) {
     const auto defect = contact_defect(record(bad), body_count);  // contact_ok's verdict, with its reason
     throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);

@@ -444,6 +444,14 @@ bool screen_contacts(const ContactView<T>& c, std::size_t body_count, std::size_
 
 }  // namespace
 
+template <class T>
+bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count) {
+  return screen_chunks(contacts.count,
+                       [&](std::size_t k0, std::size_t k1) { return screen_contacts(contacts, body_count, k0, k1); });
+}
+template bool contacts_pass_screen<float>(const ContactView<float>&, std::size_t);
+template bool contacts_pass_screen<double>(const ContactView<double>&, std::size_t);
+
 template <class T, class View>
 Validation validate_any(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                         bool needs_contact_point) {

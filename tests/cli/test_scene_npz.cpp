@@ -1,6 +1,7 @@
 // test_scene_npz.cpp - the binary scene files in process (collide/scene_npz.hpp):
 // columns used in place, conversions between precisions and id dtypes, and
 // every refusal naming the file, the member (column) and the row.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -12,8 +13,10 @@
 #include <gtest/gtest.h>
 
 #include "collide/npz.hpp"
+#include "collide/rules.hpp"
 #include "collide/scene_io.hpp"
 #include "collide/scene_npz.hpp"
+#include "collide/validate.hpp"
 
 namespace fs = std::filesystem;
 using collide::NpyType;
@@ -235,6 +238,127 @@ TEST_F(SceneNpzTest, WrittenColumnsReadBackExactly) {
   std::ifstream a(p, std::ios::binary), b(dir_ / "again.npz", std::ios::binary);
   const std::string sa((std::istreambuf_iterator<char>(a)), {}), sb((std::istreambuf_iterator<char>(b)), {});
   EXPECT_EQ(sa, sb);
+}
+
+}  // namespace
+
+namespace {
+
+/// Values at and past every bound of the rules, in T.
+template <class T>
+std::vector<T> edge_values() {
+  using L = std::numeric_limits<T>;
+  return {T(0),     -T(0),    T(1),     -T(1),   L::infinity(), -L::infinity(), L::quiet_NaN(), L::denorm_min(),
+          L::min(), L::max(), T(1e-20), T(1e20), T(0.5),        T(1.0005),      T(1.002),       T(0.9985)};
+}
+
+/// Rows of the screen tests: whole SIMD blocks and a tail.
+constexpr std::size_t kRows = 67;
+
+template <class T>
+void columnar_body_screen_is_body_ok() {
+  // Every column of one valid body set to every edge value: the columnar
+  // verdict (bodies_ok) is the row verdict (body_ok).
+  for (std::size_t k = 0; k < 17; ++k) {
+    for (const T x : edge_values<T>()) {
+      Bodies<T> b(kRows);
+      std::fill(b.col[k].begin(), b.col[k].end(), x);
+      collide::BodyColumns<T> c;
+      c.count = kRows;
+      for (std::size_t j = 0; j < 17; ++j) c.column[j] = b.col[j].data();
+      bool rows_ok = true;
+      for (std::size_t i = 0; i < kRows; ++i) rows_ok &= collide::body_ok(c.record(i));
+      EXPECT_EQ(collide::bodies_ok(c, 0, kRows), rows_ok) << "column " << k << " = " << x;
+    }
+  }
+  // The quaternion as a whole: all zero, too small, too large.
+  for (const T x : {T(0), T(1e-25), T(1e-30), T(3e19), std::numeric_limits<T>::max() / 2}) {
+    Bodies<T> b(kRows);
+    for (std::size_t k = 4; k < 8; ++k) std::fill(b.col[k].begin(), b.col[k].end(), x);
+    collide::BodyColumns<T> c;
+    c.count = kRows;
+    for (std::size_t j = 0; j < 17; ++j) c.column[j] = b.col[j].data();
+    EXPECT_EQ(collide::bodies_ok(c, 0, kRows), collide::body_ok(c.record(kRows - 1))) << "q = " << x;
+  }
+}
+
+TEST(SceneNpzRules, ColumnarBodyScreenIsBodyOk) {
+  columnar_body_screen_is_body_ok<float>();
+  columnar_body_screen_is_body_ok<double>();
+}
+
+template <class T>
+void contact_screen_clears_only_valid_contacts() {
+  // contacts_pass_screen is a sufficient test: it never clears a contact
+  // that contact_ok refuses (and clears a plainly valid one).
+  for (std::size_t k = 0; k < 8; ++k) {
+    for (const T x : edge_values<T>()) {
+      Contacts<T> c(kRows);
+      std::fill(c.col[k].begin(), c.col[k].end(), x);
+      collide::ContactView<T> v;
+      v.count = kRows;
+      v.a = c.a.data();
+      v.b = c.b.data();
+      v.c = {c.col[0].data(), c.col[1].data(), c.col[2].data()};
+      v.n = {c.col[3].data(), c.col[4].data(), c.col[5].data()};
+      v.e = c.col[6].data();
+      v.mu = c.col[7].data();
+      bool rows_ok = true;
+      for (std::size_t i = 0; i < kRows; ++i) {
+        collide::ContactRecord<T> r;
+        r.a = c.a[i];
+        r.b = c.b[i];
+        for (int j = 0; j < 3; ++j) {
+          r.c[j] = c.col[j][i];
+          r.n[j] = c.col[3 + j][i];
+        }
+        r.e = c.col[6][i];
+        r.mu = c.col[7][i];
+        rows_ok &= collide::contact_ok(r, kRows + 1);
+      }
+      if (collide::contacts_pass_screen(v, kRows + 1)) {
+        EXPECT_TRUE(rows_ok) << "column " << k << " = " << x;
+      }
+      if (k == 0 && x == T(0)) {
+        EXPECT_TRUE(collide::contacts_pass_screen(v, kRows + 1));
+      }
+    }
+  }
+}
+
+TEST(SceneNpzRules, ContactScreenClearsOnlyValidContacts) {
+  contact_screen_clears_only_valid_contacts<float>();
+  contact_screen_clears_only_valid_contacts<double>();
+}
+
+TEST_F(SceneNpzTest, DefectFoundInALargeFileAtItsRow) {
+  // Past the parallel screens' grain, so they run in chunks; each defect is
+  // reported at its row and column whatever the chunking.
+  constexpr std::size_t kN = 200000;
+  const struct {
+    std::size_t column;
+    double value;
+    const char* named;
+  } cases[] = {{0, -1, "m"},
+               {2, 0, "Iy"},
+               {8, std::numeric_limits<double>::infinity(), "px"},
+               {12, std::nan(""), "vy"},
+               {16, -std::numeric_limits<double>::infinity(), "wz"}};
+  for (const auto& c : cases) {
+    Bodies<double> d(kN);
+    d.col[c.column][kN - 7] = c.value;
+    d.col[c.column][kN - 3] = c.value;
+    const std::string p = put("big.npz", d.columns());
+    const SceneError e = scene_error([&] { (void)collide::load_bodies<double>(p, SceneFormat::npz); });
+    EXPECT_EQ(e.row(), kN - 7) << c.named;
+    EXPECT_EQ(e.column(), c.named);
+  }
+  Contacts<float> ct(kN);
+  ct.col[3][kN - 11] = 0.5f;  // |n| off unit
+  const std::string cp = put("bigc.npz", ct.columns());
+  const SceneError e = scene_error([&] { (void)collide::load_contacts<float>(cp, SceneFormat::npz, kN + 1); });
+  EXPECT_EQ(e.row(), kN - 11);
+  EXPECT_EQ(e.column(), "nx");
 }
 
 }  // namespace

@@ -131,6 +131,13 @@ struct BodyColumns {
   }
 };
 
+/// Whether bodies [i0, i1) of `columns` all obey the rules: body_ok's
+/// verdict for every one, formed column by column (loops the compiler
+/// vectorises) instead of body by body. No message: body_defect names the
+/// defect of a body.
+template <class T>
+bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) noexcept;
+
 /// A table's columns as BodyColumns (valid while the table lives unchanged).
 template <class T>
 BodyColumns<T> columns_of(const BodyTable<T>& table) {

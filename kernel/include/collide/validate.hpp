@@ -65,6 +65,14 @@ Validation validate(const PackedView<PackedParticle<T>>& bodies, const ContactVi
 /// below `body_count`, and a != b. O(count), for callers that vouch for the
 /// values (a frame loop re-solving a scene it validated once: the Python
 /// module's check=False); the message names the element like validate()'s.
+/// A quick sufficient test of the contact rules (collide/rules.hpp) over
+/// every contact, column by column on the lane layer and in parallel, as
+/// validate() screens them: true means every contact obeys them; false
+/// means one may not (a value near a bound is left to contact_ok, which
+/// decides exactly). Null e and mu count as valid, as in validate().
+template <class T>
+bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count);
+
 Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count);
 
 }  // namespace collide
