@@ -68,6 +68,9 @@
 // sees argv:
 //   --quick          float only, N in {64Ki, 4Mi}: the rows the targets need
 //   --sizes=a,b,...  the N to run (default 1e4, 64Ki, 256Ki, 1Mi, 4Mi, 16Mi)
+//   --scene=B,C      also the rows of one group on the scene in the files B
+//                    (bodies) and C (contacts), CSV or binary (.npz) by name,
+//                    named solve/file/..., schedule/file/... (N: its contacts)
 // Any --benchmark_filter gets "|^triad/" appended so that the bound is always
 // measured. The console table is tabular unless --benchmark_counters_tabular=
 // false is given; --benchmark_min_time defaults to 0.2 (seconds).
@@ -96,6 +99,7 @@
 #include "collide/generate.hpp"
 #include "collide/model.hpp"
 #include "collide/scene.hpp"
+#include "collide/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/traffic.hpp"
@@ -113,7 +117,13 @@ using collide::Path;
 // Scenes
 // ---------------------------------------------------------------------------
 
-enum class Kind { pairs, debris, pairs_mu };
+enum class Kind { pairs, debris, pairs_mu, file };
+
+/// The scene files of --scene (Kind::file).
+struct SceneFiles {
+  std::string bodies, contacts;
+};
+SceneFiles g_files;
 
 const char* kind_name(Kind kind) {
   switch (kind) {
@@ -123,6 +133,8 @@ const char* kind_name(Kind kind) {
       return "debris";
     case Kind::pairs_mu:
       return "pairs+mu";
+    case Kind::file:
+      return "file";
   }
   return "?";
 }
@@ -202,6 +214,16 @@ struct Prepared {
 
 template <class T>
 collide::Scene<T> generate(const SceneKey& key) {
+  if (key.kind == Kind::file) {
+    // Read, not drawn: every rule checked as `collide solve` checks it.
+    const auto bodies = collide::load_bodies<T>(g_files.bodies, collide::scene_format_of(g_files.bodies));
+    const auto contacts =
+        collide::load_contacts<T>(g_files.contacts, collide::scene_format_of(g_files.contacts), bodies.size());
+    collide::Scene<T> scene;
+    scene.bodies = collide::to_body_buffer(bodies.columns());
+    scene.contacts.assign_exact(contacts.view());
+    return scene;
+  }
   collide::GenerateOptions options;
   options.seed = 1;
   options.friction = key.friction || key.kind == Kind::pairs_mu;
@@ -1134,6 +1156,14 @@ Options parse_own_flags(int& argc, char** argv) {
     if (arg == "--quick") {
       options.quick = true;
       options.sizes = {65536, 4194304};
+    } else if (arg.rfind("--scene=", 0) == 0) {
+      const std::string files = arg.substr(8);
+      const std::size_t comma = files.find(',');
+      if (comma == std::string::npos || comma == 0 || comma + 1 == files.size()) {
+        std::fprintf(stderr, "collide_bench: --scene needs BODIES,CONTACTS, got '%s'\n", files.c_str());
+        std::exit(2);
+      }
+      g_files = {files.substr(0, comma), files.substr(comma + 1)};
     } else if (arg.rfind("--sizes=", 0) == 0) {
       options.sizes.clear();
       std::stringstream list(arg.substr(8));
@@ -1221,6 +1251,26 @@ int main(int argc, char** argv) {
         }
       }
     }
+  }
+
+  // The caller's scene, in each precision run, at its own N (its contacts,
+  // read from the file; a bad file stops here with the reader's message).
+  if (!g_files.bodies.empty()) {
+    std::size_t n = 0;
+    try {
+      n = collide::load_contacts<double>(g_files.contacts, collide::scene_format_of(g_files.contacts),
+                                         collide::kUnknownBodyCount)
+              .size();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "collide_bench: %s\n", e.what());
+      return 1;
+    }
+    if (n == 0) {
+      std::fprintf(stderr, "collide_bench: %s has no contacts to solve\n", g_files.contacts.c_str());
+      return 1;
+    }
+    register_group<float>(Kind::file, n);
+    if (!options.quick) register_group<double>(Kind::file, n);
   }
 
   // The body-model grid (issue: a scene pays only for what it models) at the
