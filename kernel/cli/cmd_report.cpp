@@ -19,7 +19,7 @@ namespace collide::cli {
 const char* const kReportUsage =
     "usage: collide report [--n N] [--debris-n N] [--threads LIST] [--json FILE]\n"
     "                      [--plot FILE.png] [--sample N] [--runs R] [--seed S] [--quick]\n"
-    "                      [--hard] [--hard-n N]\n"
+    "                      [--hard] [--hard-n N] [--bodies B --contacts C]\n"
     "\n"
     "Measures every variant of the solver on the pairs scene and the debris scene:\n"
     "speed (collisions per second, median of R timed runs, and the fraction of the\n"
@@ -46,6 +46,10 @@ const char* const kReportUsage =
     "                  float and double, fast and accurate mode: speed, error in\n"
     "                  eps x impulse scale and in ulps (takes seconds)\n"
     "  --hard-n N      pairs of each hard pair family (default 1000)\n"
+    "  --bodies B      also measure the scene in the files B and C (CSV, or binary\n"
+    "  --contacts C    .npz): rows of scene 'file' in float and double, with its own\n"
+    "                  friction and the models it fits; the error sample and the\n"
+    "                  slow rows use its first contacts\n"
     "\n"
     "exit codes: 0 success, 1 I/O error or gnuplot missing with --plot, 2 usage\n"
     "            error, 3 a kernel variant's error exceeds the documented bound\n"
@@ -91,7 +95,9 @@ int run_report(int argc, char** argv) {
                                      {"seed", true},
                                      {"quick", false},
                                      {"hard", false},
-                                     {"hard-n", true}});
+                                     {"hard-n", true},
+                                     {"bodies", true},
+                                     {"contacts", true}});
   if (opt.count("help") != 0) {
     std::fputs(kReportUsage, stdout);
     return kExitOk;
@@ -127,6 +133,11 @@ int run_report(int argc, char** argv) {
   if (const auto it = opt.find("hard-n"); it != opt.end()) {
     config.hard_n = parse_count("hard-n", it->second);
     if (config.hard_n < 1 || config.hard_n > 0x7FFFFFFFULL) throw UsageError("--hard-n must be from 1 to 2^31 - 1");
+  }
+  if (opt.count("bodies") != opt.count("contacts")) throw UsageError("--bodies and --contacts go together");
+  if (opt.count("bodies") != 0) {
+    config.scene_bodies = opt.at("bodies");
+    config.scene_contacts = opt.at("contacts");
   }
   if (!plot_path.empty()) {
     // Few points, so the sweep fits the budget: the two scenes of millions of

@@ -9,8 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/error_bound.hpp"
 #include "collide/npz.hpp"
 #include "collide/scene_io.hpp"
+#include "support/mini_json.hpp"
 #include "support/run_cli.hpp"
 
 namespace fs = std::filesystem;
@@ -201,6 +203,45 @@ TEST_F(CliNpzTest, ConvertRefusesWhatIsNotATable) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("x.csv:1"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(path("x.npz")));
+}
+
+TEST_F(CliNpzTest, ReportMeasuresAScenesFiles) {
+  // A sphere debris scene with friction: the report runs the models it fits
+  // (rigid and sphere, not particle: its bodies spin and rub) in both
+  // precisions, every variant within the bound, on the file's own friction.
+  ASSERT_EQ(
+      run({"gen", "--debris", "3000", "--out", dir_.string(), "--format", "npz", "--friction", "--model", "sphere"})
+          .exit_code,
+      0);
+  const RunResult r = run({"report", "--quick", "--n", "1000", "--debris-n", "1000", "--threads", "1", "--bodies",
+                           path("bodies.npz").string(), "--contacts", path("contacts.npz").string(), "--json",
+                           path("r.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const collide::test::Json json = collide::test::JsonParser(slurp(path("r.json"))).parse();
+  std::size_t file_rows = 0, kernel_rows = 0;
+  bool models[2] = {false, false};  // rigid, sphere
+  for (const collide::test::Json& row : json.at("rows").items) {
+    if (row.at("scene").str != "file") continue;
+    ++file_rows;
+    EXPECT_TRUE(row.at("friction").b) << "the file's own friction";
+    const std::string& variant = row.at("variant").str;
+    if (variant == "simd" || variant == "scalar" || variant == "accurate") {
+      ++kernel_rows;
+      EXPECT_EQ(row.at("n").num, 3000);
+      EXPECT_LE(row.at("max_err_eps").num, collide::kImpulseErrorBoundEps) << variant;
+      models[0] |= row.at("model").str == "rigid";
+      models[1] |= row.at("model").str == "sphere";
+      EXPECT_NE(row.at("model").str, "particle") << "a rotating scene with friction does not fit particles";
+    }
+  }
+  EXPECT_GT(file_rows, kernel_rows) << "the reference and textbook rows too";
+  EXPECT_TRUE(models[0] && models[1]);
+  // Only both files together, and a bad file stops the report with its message.
+  EXPECT_EQ(run({"report", "--quick", "--bodies", path("bodies.npz").string()}).exit_code, 2);
+  const RunResult bad = run({"report", "--quick", "--n", "1000", "--threads", "1", "--bodies",
+                             path("missing.npz").string(), "--contacts", path("contacts.npz").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("missing.npz"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ namespace collide {
 
 /// One measured variant.
 struct ReportRow {
-  std::string scene;      ///< "pairs" or "debris"
+  std::string scene;      ///< "pairs", "debris", or "file" (ReportOptions::scene_bodies)
   std::string variant;    ///< "reference", "textbook", "scalar", "simd", "accurate" or "bullet"
   std::string model;      ///< "particle", "sphere" or "rigid"
   std::string precision;  ///< "float", "double" or "long double"
@@ -164,6 +164,12 @@ struct ReportOptions {
   /// and double, fast and accurate, SIMD at one thread (`--hard`).
   bool hard = false;
   std::size_t hard_n = 1000;  ///< pairs of each hard pair family (the shared scenes have fixed sizes)
+  /// A scene of the caller's, measured beside pairs and debris as the rows of
+  /// scene "file" (both empty: none): its bodies and contacts files, CSV or
+  /// binary (.npz) by name, in float and double, its own friction, the
+  /// models it fits; the error sample and the slow rows on its first
+  /// contacts.
+  std::string scene_bodies, scene_contacts;
 };
 
 /// Measures every row (and the sweep) and returns them in canonical order

@@ -124,8 +124,11 @@ std::string label(const ReportRow& r) {
 void sort_report_rows(Report& report) {
   auto key = [](const ReportRow& r) {
     const bool kernel = is_kernel_variant(r.variant);
-    return std::make_tuple(r.scene == "pairs" ? 0 : 1, r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant),
-                           model_rank(r.model), precision_rank(r.precision), variant_rank(r.variant), r.isa, r.threads);
+    return std::make_tuple(r.scene == "pairs"    ? 0
+                           : r.scene == "debris" ? 1
+                                                 : 2,
+                           r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant), model_rank(r.model),
+                           precision_rank(r.precision), variant_rank(r.variant), r.isa, r.threads);
   };
   std::stable_sort(report.rows.begin(), report.rows.end(),
                    [&](const ReportRow& a, const ReportRow& b) { return key(a) < key(b); });

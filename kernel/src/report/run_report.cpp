@@ -72,6 +72,7 @@
 #include "collide/rules.hpp"
 #include "collide/scene.hpp"
 #include "collide/scene_io.hpp"
+#include "collide/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/traffic.hpp"
@@ -126,8 +127,53 @@ class Progress {
 // Scenes.
 // ---------------------------------------------------------------------------
 
-enum class SceneKind { pairs, debris };
-const char* scene_name(SceneKind kind) { return kind == SceneKind::pairs ? "pairs" : "debris"; }
+enum class SceneKind { pairs, debris, file };
+const char* scene_name(SceneKind kind) {
+  return kind == SceneKind::pairs ? "pairs" : kind == SceneKind::debris ? "debris" : "file";
+}
+
+/// The caller's scene (ReportOptions::scene_bodies, scene_contacts) in T,
+/// every rule checked as `collide solve` checks it.
+template <class T>
+Scene<T> read_scene_files(const std::string& bodies_path, const std::string& contacts_path) {
+  const LoadedBodies<T> bodies = load_bodies<T>(bodies_path, scene_format_of(bodies_path));
+  const LoadedContacts<T> contacts = load_contacts<T>(contacts_path, scene_format_of(contacts_path), bodies.size());
+  Scene<T> scene;
+  scene.bodies = to_body_buffer(bodies.columns());
+  scene.contacts.assign_exact(contacts.view());
+  return scene;
+}
+
+/// The first `k` contacts of a scene with only the bodies they touch,
+/// renumbered in order of first use. The law applies contacts in input
+/// order, so each of them gets the impulse it gets in the whole scene; the
+/// reference of a sample then needs the sample's bodies, not all of them.
+template <class T>
+Scene<T> contact_prefix(const Scene<T>& scene, std::size_t k) {
+  const ContactView<T> c = scene.contacts.view();
+  const BodyView<const T> b = scene.bodies.view();
+  k = std::min(k, c.count);
+  std::vector<BodyIndex> id(b.count, std::numeric_limits<BodyIndex>::max());
+  std::vector<BodyIndex> used;
+  const auto renumber = [&](BodyIndex i) {
+    if (id[i] == std::numeric_limits<BodyIndex>::max()) {
+      id[i] = static_cast<BodyIndex>(used.size());
+      used.push_back(i);
+    }
+    return id[i];
+  };
+  Scene<T> out;
+  out.contacts.resize(k);
+  for (std::size_t j = 0; j < k; ++j) {
+    ContactRecord<T> r = scene.contacts.record(j);
+    r.a = renumber(r.a);
+    r.b = renumber(r.b);
+    out.contacts.set(j, r);
+  }
+  out.bodies.resize(used.size());
+  for (std::size_t i = 0; i < used.size(); ++i) out.bodies.set(i, scene.bodies.record(used[i]));
+  return out;
+}
 
 template <class T>
 Scene<T> make_scene(SceneKind kind, std::size_t n, bool friction, std::uint64_t seed) {
@@ -215,6 +261,11 @@ class Runner {
         run_scene<float>(kind, friction);
       }
       end_phase(scene_name(kind));
+    }
+    if (!config_.scene_bodies.empty()) {
+      run_file_scene<double>();
+      run_file_scene<float>();
+      end_phase("file");
     }
     if (config_.hard) {
       report_.hard = measure_hard_rows(config_, [&](const std::string& what) { progress_->show(what); });
@@ -384,6 +435,24 @@ class Runner {
     progress_->show(what + ": generating " + std::to_string(n) + " collisions");
     Scene<T> scene = make_scene<T>(kind, n, friction, config_.seed);
     Scene<T> sample = make_scene<T>(kind, sample_size(), friction, config_.seed);
+    measure_scene(kind, friction, scene, std::move(sample));
+  }
+
+  /// The caller's scene files: its own friction, and only the models it fits
+  /// (its bodies are the caller's, not reshaped for a model).
+  template <class T>
+  void run_file_scene() {
+    const std::string what = std::string("file ") + precision_name<T>();
+    progress_->show(what + ": reading " + config_.scene_bodies + " and " + config_.scene_contacts);
+    Scene<T> scene = read_scene_files<T>(config_.scene_bodies, config_.scene_contacts);
+    const Scene<T> sample = contact_prefix(scene, sample_size());
+    measure_scene(SceneKind::file, scene.contacts.view().mu != nullptr, scene, sample);
+  }
+
+  template <class T>
+  void measure_scene(SceneKind kind, bool friction, Scene<T>& scene, Scene<T> sample) {
+    const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
+    const std::size_t n = scene.contacts.size();
     Schedule schedule, sample_schedule;
     schedule.build(scene.contacts.view(), scene.bodies.view());
     sample_schedule.build(sample.contacts.view(), sample.bodies.view());
@@ -392,7 +461,9 @@ class Runner {
     const double eps = std::numeric_limits<T>::epsilon();
 
     for (const Model model : kModels) {
-      if (model != Model::rigid) {
+      if (kind == SceneKind::file) {
+        if (!model_misfit(model, scene.bodies.view(), scene.contacts.view()).empty()) continue;
+      } else if (model != Model::rigid) {
         derive_model(scene, model);
         derive_model(sample, model);
       }
@@ -460,11 +531,18 @@ class Runner {
   /// reference_solve<long double> and <double> on the rigid double scene.
   void slow_reference_rows(SceneKind kind, bool friction, const Scene<double>& scene, const Scene<double>& sample,
                            const ReferenceResult& reference) {
-    const ContactView<double> contacts = slow_contacts(scene);
+    ContactView<double> contacts = slow_contacts(scene);
     // Pairs touch only their own two bodies, so the slow prefix needs only
     // the first 2 slow_n of them; debris contacts reach every body.
     BodyView<const double> body_src = scene.bodies.view();
     if (kind == SceneKind::pairs) body_src.count = std::min(body_src.count, 2 * contacts.count);
+    // A file's prefix may touch any of its bodies: only those it touches.
+    Scene<double> prefix;
+    if (kind == SceneKind::file) {
+      prefix = contact_prefix(scene, contacts.count);
+      body_src = std::as_const(prefix.bodies).view();
+      contacts = prefix.contacts.view();
+    }
     {
       // long double: the yardstick itself (its error is 0 by definition; the
       // comparison still runs, as a check that it is deterministic).
@@ -617,6 +695,8 @@ Report measure_report(const ReportOptions& options) {
     require(n >= 1 && n <= 0x7FFFFFFFULL, "sweep sizes must be from 1 to 2^31 - 1");
   }
   require(options.hard_n >= 1 && options.hard_n <= 0x7FFFFFFFULL, "hard_n must be from 1 to 2^31 - 1");
+  require(options.scene_bodies.empty() == options.scene_contacts.empty(),
+          "a scene of files needs both its bodies and its contacts file");
   const auto t0 = Clock::now();
   Report report;
   report.n = options.n;
