@@ -565,23 +565,26 @@ BodyTable<T> read_bodies(const std::string& path) {
 template <class T>
 bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) noexcept {
   // The rules of body_ok (collide/rules.hpp), one column at a time and
-  // without a branch per value: x - x == 0 exactly when x is finite.
+  // without a branch per value, defects OR-ed into an integer so that the
+  // loops vectorise: x - x == 0 exactly when x is finite.
   const auto finite = [](T x) { return (x - x) == T(0); };
-  bool ok = true;
+  unsigned bad = 0;
   for (std::size_t k = 0; k < 4; ++k) {  // m and the moments: > 0 with a finite inverse (inf is allowed)
     const T* x = columns.column[k];
-    for (std::size_t i = i0; i < i1; ++i) ok &= (x[i] > T(0)) & finite(T(1) / x[i]);
+    for (std::size_t i = i0; i < i1; ++i) {
+      bad |= static_cast<unsigned>(!(x[i] > T(0))) | static_cast<unsigned>(!finite(T(1) / x[i]));
+    }
   }
   for (std::size_t k = 4; k < columns.column.size(); ++k) {
     const T* x = columns.column[k];
-    for (std::size_t i = i0; i < i1; ++i) ok &= finite(x[i]);
+    for (std::size_t i = i0; i < i1; ++i) bad |= static_cast<unsigned>(!finite(x[i]));
   }
   const T *qw = columns.column[4], *qx = columns.column[5], *qy = columns.column[6], *qz = columns.column[7];
   for (std::size_t i = i0; i < i1; ++i) {
     const T q2 = quaternion_square(qw[i], qx[i], qy[i], qz[i]);  // quaternion_normalisable, without a branch
-    ok &= finite(q2) & (q2 >= std::numeric_limits<T>::min());
+    bad |= static_cast<unsigned>(!finite(q2)) | static_cast<unsigned>(!(q2 >= std::numeric_limits<T>::min()));
   }
-  return ok;
+  return bad == 0;
 }
 
 template <class T>
