@@ -31,6 +31,7 @@
 #include "collide/scene_io.hpp"
 
 #include "input_file.hpp"
+#include "screen_chunks.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -54,7 +55,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_pipeline.h>
-#include <oneapi/tbb/parallel_reduce.h>
 #include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
 
@@ -593,10 +593,8 @@ BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table) {
   // The rules first, in parallel and without messages (body_ok); a table
   // that breaks one goes through set(), which names the first defect as it
   // always has.
-  const bool ok = oneapi::tbb::parallel_reduce(
-      Range(0, table.size(), 1 << 14), true,
-      [&](const Range& r, bool so_far) { return so_far && bodies_ok(table, r.begin(), r.end()); },
-      [](bool x, bool y) { return x && y; });
+  const bool ok =
+      detail::screen_chunks(table.size(), [&](std::size_t i0, std::size_t i1) { return bodies_ok(table, i0, i1); });
   if (!ok) {
     BodyBuffer<T> named(table.size());
     for (std::size_t i = 0; i < table.size(); ++i) named.set(i, table.record(i));  // throws at the first defect

@@ -21,7 +21,6 @@
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/parallel_reduce.h>
 
 #include <charconv>
 #include <cmath>
@@ -34,6 +33,7 @@
 
 #include "collide/rules.hpp"
 #include "collide/validate.hpp"
+#include "screen_chunks.hpp"
 
 namespace collide {
 
@@ -98,23 +98,12 @@ std::array<const NpzMember*, N> table_members(const NpzArchive& archive, const s
   return found;
 }
 
-/// True when every chunk of [0, n) passes `ok(begin, end)`; in parallel.
-template <class F>
-bool all_chunks(std::size_t n, const F& ok) {
-  constexpr std::size_t kGrain = std::size_t{1} << 15;
-  if (n < 2 * kGrain) return ok(std::size_t{0}, n);
-  return oneapi::tbb::parallel_reduce(
-      oneapi::tbb::blocked_range<std::size_t>(0, n, kGrain), true,
-      [&](const oneapi::tbb::blocked_range<std::size_t>& r, bool so_far) { return so_far && ok(r.begin(), r.end()); },
-      [](bool x, bool y) { return x && y; });
-}
-
 /// The first row i of [0, n) for which ok(i) is false, or n. Screened in
 /// parallel chunks; only a failed screen is scanned again, row by row on
 /// one thread, so the row found does not depend on threads.
 template <class Ok>
 std::size_t first_failing_row(std::size_t n, const Ok& ok) {
-  const bool all = all_chunks(n, [&](std::size_t i0, std::size_t i1) {
+  const bool all = detail::screen_chunks(n, [&](std::size_t i0, std::size_t i1) {
     bool good = true;
     for (std::size_t i = i0; i < i1; ++i) good &= ok(i);
     return good;
@@ -123,6 +112,12 @@ std::size_t first_failing_row(std::size_t n, const Ok& ok) {
   std::size_t i = 0;
   while (i < n && ok(i)) ++i;
   return i;
+}
+
+std::string shortest_text(double x) {
+  std::string s;
+  append_number(s, x);  // the writers' shortest round-trip text
+  return s;
 }
 
 template <class From, class T>
@@ -135,12 +130,6 @@ void convert_into(const std::byte* data, std::size_t n, T* out) {
                                 out[i] = static_cast<T>(x);
                               }
                             });
-}
-
-std::string shortest(double x) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x);
-  return std::string(buf, r.ptr);
 }
 
 /// Column `m` in precision T: the member's own bytes when it holds T and is
@@ -177,7 +166,7 @@ const T* real_column(const NpzArchive& archive, const NpzMember& m, NpyType prec
           m.count, [&](std::size_t i) { return !std::isfinite(stored(i)) || std::isfinite(owned[i]); });
       if (bad < m.count) {
         throw SceneError(archive.file_name(), 0, bad, m.name,
-                         "value " + shortest(stored(bad)) + " is out of the range of float");
+                         "value " + shortest_text(stored(bad)) + " is out of the range of float");
       }
     }
   }
@@ -273,7 +262,8 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
     out.mapped_ |= in_place;
   }
   const BodyColumns<T>& columns = out.columns_;
-  const bool screened = all_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); });
+  const bool screened =
+      detail::screen_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); });
   const std::size_t bad =
       screened ? n : first_failing_row(n, [&](std::size_t i) { return body_ok(columns.record(i)); });
   if (bad < n) {

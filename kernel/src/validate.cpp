@@ -14,6 +14,7 @@
 //    problem so the message names one element. It runs only when a screen
 //    fails, so the message does not depend on the screens.
 #include "collide/validate.hpp"
+#include "screen_chunks.hpp"
 
 #include <algorithm>
 #include <array>
@@ -24,9 +25,6 @@
 #include <sstream>
 #include <type_traits>
 #include <vector>
-
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_reduce.h>
 
 #include "collide/rules.hpp"
 
@@ -335,20 +333,6 @@ bool screen_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, s
   return bad == 0;
 }
 
-/// True when f(begin, end) is true for every chunk of [0, count): on the
-/// calling thread for small counts, else in parallel (TBB's arena of the
-/// calling thread), since at a million contacts a screen is bound by one
-/// core's memory bandwidth.
-template <class F>
-bool screen_chunks(std::size_t count, const F& f) {
-  constexpr std::size_t kGrain = std::size_t{1} << 15;
-  if (count < 2 * kGrain) return f(std::size_t{0}, count);
-  return tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, count, kGrain), true,
-      [&](const tbb::blocked_range<std::size_t>& r, bool ok) { return ok && f(r.begin(), r.end()); },
-      [](bool x, bool y) { return x && y; });
-}
-
 /// The body rules of validate_any's scan, screened over bodies [i0, i1) of
 /// SoA views: one screen per array, and |q| for the rigid model.
 template <class T>
@@ -446,8 +430,8 @@ bool screen_contacts(const ContactView<T>& c, std::size_t body_count, std::size_
 
 template <class T>
 bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count) {
-  return screen_chunks(contacts.count,
-                       [&](std::size_t k0, std::size_t k1) { return screen_contacts(contacts, body_count, k0, k1); });
+  return detail::screen_chunks(
+      contacts.count, [&](std::size_t k0, std::size_t k1) { return screen_contacts(contacts, body_count, k0, k1); });
 }
 template bool contacts_pass_screen<float>(const ContactView<float>&, std::size_t);
 template bool contacts_pass_screen<double>(const ContactView<double>&, std::size_t);
@@ -481,10 +465,11 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
 
   const bool uniform_e_ok = contacts.e != nullptr || (contacts.uniform_e >= T(0) && contacts.uniform_e <= T(1));
   if (uniform_e_ok &&
-      screen_chunks(bodies.count,
-                    [&](std::size_t i0, std::size_t i1) { return screen_bodies(bodies, fields, i0, i1); }) &&
-      screen_chunks(contacts.count,
-                    [&](std::size_t k0, std::size_t k1) { return screen_contacts(contacts, bodies.count, k0, k1); })) {
+      detail::screen_chunks(bodies.count,
+                            [&](std::size_t i0, std::size_t i1) { return screen_bodies(bodies, fields, i0, i1); }) &&
+      detail::screen_chunks(contacts.count, [&](std::size_t k0, std::size_t k1) {
+        return screen_contacts(contacts, bodies.count, k0, k1);
+      })) {
     return {};
   }
 
@@ -561,7 +546,7 @@ Validation validate(const PackedView<PackedParticle<T>>& bodies, const ContactVi
 }
 
 Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count) {
-  if (screen_chunks(
+  if (detail::screen_chunks(
           count, [&](std::size_t k0, std::size_t k1) { return screen_indices(a + k0, b + k0, k1 - k0, body_count); })) {
     return {};
   }
