@@ -6,15 +6,16 @@
 #   own switch, read by add_library in kernel/CMakeLists.txt).
 # * What a consumer needs is exactly the public link interface:
 #     - the headers (C++17, no TBB, no Eigen: both are used only in .cpp files);
-#     - for a static archive, TBB and zlib as well, because an archive cannot
-#       carry its own dependencies. The exported target says so
-#       ($<LINK_ONLY:TBB::tbb>, $<LINK_ONLY:ZLIB::ZLIB>, which CMake adds for a
-#       PRIVATE dependency of a static library), so the config file calls
-#       find_dependency(TBB) and find_dependency(ZLIB) in that case only.
+#     - for a static archive, TBB and libdeflate as well, because an archive
+#       cannot carry its own dependencies. The exported target says so
+#       ($<LINK_ONLY:TBB::tbb>, $<LINK_ONLY:PkgConfig::LIBDEFLATE>, which CMake
+#       adds for a PRIVATE dependency of a static library), so the config file
+#       calls find_dependency(TBB) and finds libdeflate through pkg-config in
+#       that case only.
 #       Eigen never reaches the interface (it is a $<BUILD_INTERFACE>
 #       dependency).
 # * Three ways in, one target name: find_package(collide) and add_subdirectory
-#   both give collide::collide; pkg-config gives collide.pc, whose -ltbb -lz sit in
+#   both give collide::collide; pkg-config gives collide.pc, whose -ltbb -ldeflate sit in
 #   Libs.private for a static install (`pkg-config --static`), as pkg-config
 #   intends private dependencies to be spelled.
 # * The .pc file locates its prefix from its own directory (${pcfiledir}), so
@@ -123,18 +124,10 @@ if(COLLIDE_NEEDS_TBB)
     endif()
   endif()
   string(APPEND COLLIDE_PC_LIBS_PRIVATE "-ltbb")
-  # zlib: the .npz writer's CRC-32 (kernel/CMakeLists.txt); -L as for TBB.
-  get_target_property(_collide_zlib_location ZLIB::ZLIB IMPORTED_LOCATION_RELEASE)
-  if(NOT _collide_zlib_location)
-    get_target_property(_collide_zlib_location ZLIB::ZLIB IMPORTED_LOCATION)
-  endif()
-  if(_collide_zlib_location)
-    get_filename_component(_collide_zlib_dir ${_collide_zlib_location} DIRECTORY)
-    if(NOT _collide_zlib_dir IN_LIST CMAKE_CXX_IMPLICIT_LINK_DIRECTORIES)
-      string(APPEND COLLIDE_PC_LIBS_PRIVATE " -L${_collide_zlib_dir}")
-    endif()
-  endif()
-  string(APPEND COLLIDE_PC_LIBS_PRIVATE " -lz")
+  # libdeflate: the .npz writer's CRC-32 (kernel/CMakeLists.txt); its own
+  # pkg-config flags, which carry a -L where it is not in the linker's path.
+  list(JOIN LIBDEFLATE_LDFLAGS " " _collide_deflate_flags)
+  string(APPEND COLLIDE_PC_LIBS_PRIVATE " ${_collide_deflate_flags}")
   # libquadmath: the __float128 reference's sqrtq (kernel/CMakeLists.txt);
   # GCC's own runtime, in the linker's default path.
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")

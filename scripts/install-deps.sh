@@ -3,7 +3,7 @@
 # Downloads nothing else. Run as root, or with sudo available.
 set -euo pipefail
 
-# zlib1g-dev: the CRC-32 of the .npz scene writer.
+# libdeflate-dev: the CRC-32 of the .npz scene writer.
 # gnuplot-nox draws the report's plot and the debris example's picture;
 # libbullet-dev gives `collide report` its peer row (optional in CMake).
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
@@ -13,7 +13,7 @@ set -euo pipefail
 # pip install test reuses the normal build's objects (python/CMakeLists.txt).
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
 # scripts/ci-sanitizers.sh.
-packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev zlib1g-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
+packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev libdeflate-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
   clang-14 libclang-rt-14-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip)
 

@@ -34,16 +34,17 @@
 //   the .npy header of a 1-D array to a multiple of 64 bytes, so the array
 //   data that follows is aligned too.
 // * The writer never seeks, so the CRC-32 that the local header holds must
-//   be known before the data is written: it is computed first, chunks in
-//   parallel joined in order with crc32_combine, and the data is then
-//   written straight from the caller's array.
+//   be known before the data is written: every member's is computed first,
+//   the members in parallel, each by libdeflate (carry-less multiplication
+//   where the CPU has it: 8 GB/s on one Zen 3 core against zlib's 2-3), and
+//   the data is then written straight from the caller's array.
 #include "collide/npz.hpp"
 
 #include <fcntl.h>
+#include <libdeflate.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <array>
@@ -59,7 +60,6 @@
 #include <unordered_set>
 #include <utility>
 
-#include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
 #include "collide/scene_io.hpp"
@@ -723,10 +723,6 @@ constexpr std::size_t kCentralZip64ExtraSize = 4 + 24;  // uncompressed, compres
 // digits (numpy.lib.format.GROWTH_AXIS_MAX_DIGITS) before padding.
 constexpr std::size_t kGrowthAxisMaxDigits = 21;
 constexpr std::size_t kNpyAlign = 64;  // numpy.lib.format.ARRAY_ALIGN
-// Bytes per parallel CRC chunk: large enough that crc32_combine's cost and
-// the scheduling overhead vanish, small enough to keep every core busy on a
-// column of a few megabytes.
-constexpr std::size_t kCrcChunk = std::size_t(1) << 20;
 
 void put16(std::string& out, std::uint16_t v) {
   out += static_cast<char>(v & 0xFF);
@@ -758,23 +754,12 @@ std::string npy_header(NpyType type, std::size_t count) {
   return header + dict;
 }
 
-std::uint32_t crc32_of(const void* data, std::size_t size) {
-  const auto* bytes = static_cast<const Bytef*>(data);
-  if (size <= kCrcChunk) return static_cast<std::uint32_t>(crc32_z(0, bytes, size));
-  const std::size_t chunks = (size + kCrcChunk - 1) / kCrcChunk;
-  std::vector<uLong> crcs(chunks);
-  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, chunks),
-                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                              for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                                const std::size_t begin = c * kCrcChunk;
-                                crcs[c] = crc32_z(0, bytes + begin, std::min(kCrcChunk, size - begin));
-                              }
-                            });
-  uLong crc = crcs[0];
-  for (std::size_t c = 1; c < chunks; ++c) {
-    crc = crc32_combine(crc, crcs[c], static_cast<z_off_t>(std::min(kCrcChunk, size - c * kCrcChunk)));
-  }
-  return static_cast<std::uint32_t>(crc);
+/// The CRC-32 of a member: its .npy header, then its array data. (Given a
+/// null buffer, libdeflate_crc32 returns the initial value, not `crc`: an
+/// empty column, whose data may be null, adds nothing.)
+std::uint32_t member_crc(const std::string& npy, const void* data, std::size_t data_size) {
+  const std::uint32_t header = libdeflate_crc32(0, npy.data(), npy.size());
+  return data_size == 0 ? header : libdeflate_crc32(header, data, data_size);
 }
 
 /// One member as written: its .npy header, where its local header starts,
@@ -822,18 +807,24 @@ void write_archive(const std::vector<NpzColumn>& columns, Sink&& sink) {
     sink(end);
     return;
   }
+  // Every member's CRC first, the members in parallel (see the design notes).
+  std::vector<std::uint32_t> crcs(columns.size());
+  oneapi::tbb::parallel_for(std::size_t{0}, columns.size(), [&](std::size_t k) {
+    const NpzColumn& column = columns[k];
+    crcs[k] = member_crc(npy_header(column.type, column.count), column.data, column.count * npy_type_size(column.type));
+  });
   std::uint64_t offset = 0;
   std::vector<WrittenMember> written;
   written.reserve(columns.size());
-  for (const NpzColumn& column : columns) {
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    const NpzColumn& column = columns[k];
     const std::string npy = npy_header(column.type, column.count);
     const std::size_t data_size = column.count * npy_type_size(column.type);
     WrittenMember member;
     member.name = std::string(column.name) + std::string(kNpySuffix);
     member.local_offset = offset;
     member.size = npy.size() + data_size;
-    member.crc = crc32_combine(crc32_z(0, reinterpret_cast<const Bytef*>(npy.data()), npy.size()),
-                               crc32_of(column.data, data_size), static_cast<z_off_t>(data_size));
+    member.crc = crcs[k];
     const bool ascii = std::all_of(member.name.begin(), member.name.end(),
                                    [](char c) { return static_cast<unsigned char>(c) < 0x80; });
     member.flags = ascii ? 0 : kUtf8NameFlag;

@@ -19,9 +19,9 @@
 //   columns (fixed timestamps, no random fields), with each array's data
 //   aligned to kNpzAlignment bytes in the file (by padding the local
 //   header's extra field, as zipalign does), so a mapped member is aligned
-//   for every element type. The writer never seeks: CRCs (zlib's crc32,
-//   chunks in parallel joined by crc32_combine) are computed before a
-//   member is written, so a FIFO or stdout works as for CSV.
+//   for every element type. The writer never seeks: CRCs (libdeflate's, the
+//   members in parallel) are computed before a member is written, so a FIFO
+//   or stdout works as for CSV.
 //
 // The header is C++17, like the rest of the public API.
 #pragma once
