@@ -22,11 +22,16 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
+#include <sys/mman.h>
+
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -274,7 +279,27 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
 }
 
 template <class T>
-SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns) : count_(columns.count), own_(new T[10 * columns.count]) {
+void SolveBodies<T>::Free::operator()(T* p) const noexcept {
+  std::free(p);
+}
+
+namespace {
+/// Uncleared memory for n values of T, in 2 MiB pages where the kernel gives
+/// them (madvise), so that first touch faults once per 2 MiB, not per 4 KiB.
+template <class T>
+T* allocate_large(std::size_t n) {
+  constexpr std::size_t kHuge = std::size_t{2} << 20;
+  const std::size_t bytes = std::max<std::size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
+  void* p = std::aligned_alloc(kHuge, bytes);
+  if (p == nullptr) throw std::bad_alloc();
+  ::madvise(p, bytes, MADV_HUGEPAGE);
+  return static_cast<T*>(p);
+}
+}  // namespace
+
+template <class T>
+SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
+    : count_(columns.count), own_(allocate_large<T>(10 * columns.count)) {
   for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
   BodyView<T> v = view();
   inverses_of(columns, v.inv_mass, v.inv_inertia);

@@ -113,7 +113,8 @@ class LoadedContacts {
 /// file's): q and p are read where the columns hold them (a mapped file's
 /// pages, a table) and never copied; 1/m and 1/I (inverses_of) and v and w,
 /// which the solve writes, live in arrays of its own, allocated without
-/// being cleared first. view() is valid while the columns are. Not
+/// being cleared first, in 2 MiB pages where the system gives them (a 4M-pair
+/// binary read took 0.17-0.25 s with 4 KiB pages, 0.11-0.13 s with these). view() is valid while the columns are. Not
 /// copyable; movable.
 template <class T>
 class SolveBodies {
@@ -127,7 +128,10 @@ class SolveBodies {
 
  private:
   std::size_t count_ = 0;
-  std::unique_ptr<T[]> own_;        // inv_mass, Ix, Iy, Iz, vx, vy, vz, wx, wy, wz: 10 runs of count_
+  struct Free {
+    void operator()(T* p) const noexcept;
+  };
+  std::unique_ptr<T[], Free> own_;  // inv_mass, Ix, Iy, Iz, vx, vy, vz, wx, wy, wz: 10 runs of count_
   std::array<const T*, 7> read_{};  // qw, qx, qy, qz, px, py, pz
 };
 
