@@ -113,9 +113,9 @@ class LoadedContacts {
 /// file's): q and p are read where the columns hold them (a mapped file's
 /// pages, a table) and never copied; 1/m and 1/I (inverses_of) and v and w,
 /// which the solve writes, live in arrays of its own, allocated without
-/// being cleared first, in 2 MiB pages where the system gives them (a 4M-pair
-/// binary read took 0.17-0.25 s with 4 KiB pages, 0.11-0.13 s with these). view() is valid while the columns are. Not
-/// copyable; movable.
+/// being cleared first, in 2 MiB pages where the system gives them (first
+/// touch faults once per 2 MiB; docs/decisions/0002-binary-scene-files.md).
+/// view() is valid while the columns are. Not copyable; movable.
 template <class T>
 class SolveBodies {
  public:
