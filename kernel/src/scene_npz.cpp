@@ -330,14 +330,7 @@ BodyView<T> SolveBodies<T>::view() {
 
 template <class T>
 BodyView<const T> SolveBodies<T>::view() const {
-  const BodyView<T> v = const_cast<SolveBodies*>(this)->view();
-  return {v.count,
-          v.inv_mass,
-          {v.inv_inertia.x, v.inv_inertia.y, v.inv_inertia.z},
-          {v.q.w, v.q.x, v.q.y, v.q.z},
-          {v.p.x, v.p.y, v.p.z},
-          {v.v.x, v.v.y, v.v.z},
-          {v.w.x, v.w.y, v.w.z}};
+  return const_view(const_cast<SolveBodies*>(this)->view());
 }
 
 template <class T>

@@ -213,18 +213,6 @@ struct Bodies {
   }
 };
 
-/// The read-only form of a body view.
-template <class T>
-BodyView<const T> const_view(const BodyView<T>& b) {
-  return {b.count,
-          b.inv_mass,
-          {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z},
-          {b.q.w, b.q.x, b.q.y, b.q.z},
-          {b.p.x, b.p.y, b.p.z},
-          {b.v.x, b.v.y, b.v.z},
-          {b.w.x, b.w.y, b.w.z}};
-}
-
 struct Contacts {
   py::array a, b, c, n;
   std::optional<py::array> e, mu;

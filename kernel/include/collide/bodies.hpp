@@ -97,6 +97,18 @@ ParticleView<T> particle_view(const BodyView<T>& b) {
   return {b.count, b.inv_mass, b.v};
 }
 
+/// The read-only form of a body view (the same arrays).
+template <class T>
+BodyView<const T> const_view(const BodyView<T>& b) {
+  return {b.count,
+          b.inv_mass,
+          {b.inv_inertia.x, b.inv_inertia.y, b.inv_inertia.z},
+          {b.q.w, b.q.x, b.q.y, b.q.z},
+          {b.p.x, b.p.y, b.p.z},
+          {b.v.x, b.v.y, b.v.z},
+          {b.w.x, b.w.y, b.w.z}};
+}
+
 /// One body as a scene file describes it, in physical units. Convenience for
 /// building scenes; the kernels never see this type.
 template <class T>
