@@ -95,14 +95,14 @@
 #include <utility>
 #include <vector>
 
-#include "collide/bandwidth.hpp"
-#include "collide/generate.hpp"
+#include "collide/eval/bandwidth.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/model.hpp"
-#include "collide/scene.hpp"
-#include "collide/scene_npz.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
-#include "collide/traffic.hpp"
+#include "collide/eval/traffic.hpp"
 #include "memory_twin.hpp"
 #include "packed_twin.hpp"
 #include "support.hpp"
@@ -334,7 +334,7 @@ std::string model_name(Kind kind, collide::Model model, bool friction, const cha
   return std::string("model/") + kind_name(kind) + "/" + collide::to_string(model) + (friction ? "+mu" : "") + "/" +
          precision + "/simd/t:" + std::to_string(threads) + "/n:" + std::to_string(n);
 }
-/// Which body layout a layout row runs (issue 11).
+/// Which body layout a layout row runs.
 enum class LayoutRow {
   soa,      ///< the SoA arrays in place (SolverOptions::layout = soa)
   packed,   ///< SoA input that the solver packs, solves and writes back (layout = packed)
@@ -429,7 +429,7 @@ void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int
 /// One body model on a scene whose bodies fit it (GenerateOptions::model),
 /// through the Model-dispatching Solver::solve: the views of the smaller
 /// models read only their own arrays, so the bytes per collision are the
-/// model's own (collide/traffic.hpp).
+/// model's own (collide/eval/traffic.hpp).
 template <class T>
 void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
                collide::Accuracy accuracy = collide::Accuracy::fast) {
@@ -677,7 +677,7 @@ void register_models(Kind kind, std::size_t n) {
         add_row(model_name(kind, model, friction, precision_name<T>(), threads, n),
                 [=](benchmark::State& s) { model_row<T>(s, kind, n, model, friction, threads); });
       }
-      // The accurate mode (issue 13) on the same scene: its cost against the
+      // The accurate mode on the same scene: its cost against the
       // rows above.
       for (const int threads : {1, 2}) {
         add_row("accurate/" + model_name(kind, model, friction, precision_name<T>(), threads, n).substr(6),
@@ -685,7 +685,7 @@ void register_models(Kind kind, std::size_t n) {
                   model_row<T>(s, kind, n, model, friction, threads, collide::Accuracy::accurate);
                 });
       }
-      // Both layouts (issue 11), on the scene the rows above just used.
+      // Both layouts, on the scene the rows above just used.
       for (const LayoutRow layout : {LayoutRow::soa, LayoutRow::packed, LayoutRow::records}) {
         for (const int threads : {1, 2}) {
           add_row(layout_name(kind, model, friction, precision_name<T>(), layout, threads, n),
@@ -918,7 +918,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
            t1.valid && t2.valid ? t2.coll_per_s / t1.coll_per_s : 0, 1.8, "x");
   }
   {
-    // Issue 12: the widest ISA against AVX2, in cache and streaming.
+    // The widest ISA against AVX2, in cache and streaming.
     using collide::Isa;
     auto ratio = [&](Kind kind, Isa a, Isa b, int threads, std::size_t n) {
       const Result ra = rep.get(isa_name(kind, f32, a, threads, n));
@@ -939,7 +939,7 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     }
   }
   {
-    // Issue 11: scattered scenes on the packed layout.
+    // Scattered scenes on the packed layout.
     using collide::Model;
     auto per_s = [&](const std::string& name) {
       const Result r = rep.get(name);
@@ -1273,7 +1273,7 @@ int main(int argc, char** argv) {
     if (!options.quick) register_group<double>(Kind::file, n);
   }
 
-  // The body-model grid (issue: a scene pays only for what it models) at the
+  // The body-model grid (a scene pays only for what it models) at the
   // two sizes its targets name: in cache and streaming.
   for (Kind kind : {Kind::pairs, Kind::debris}) {
     for (int precision : {4, 8}) {

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "collide/traffic.hpp"
+#include "collide/eval/traffic.hpp"
 #include "lanes.hpp"
 
 namespace collide_bench {
@@ -53,12 +53,12 @@ TwinArrays<T> arrays_of(collide::Model model, const collide::BodyView<T>& b, con
   a.contact_read.insert(a.contact_read.end(), {c.n.x, c.n.y, c.n.z});
   if (c.e) a.contact_read.push_back(c.e);
   if (c.mu) a.contact_read.push_back(c.mu);
-  // The same arrays that collide/traffic.hpp counts for the model, or the
+  // The same arrays that collide/eval/traffic.hpp counts for the model, or the
   // twin's GB/s would not be comparable with the kernel's.
   const std::size_t contact_values = (model == Model::particle ? 0 : 3) + 3 + (c.e ? 1 : 0) + (c.mu ? 1 : 0);
   if (a.body_read.size() != collide::body_values_read(model) ||
       a.body_written.size() != collide::body_values_written(model) || a.contact_read.size() != contact_values) {
-    throw std::logic_error("memory_twin: the twin's arrays differ from collide/traffic.hpp's count");
+    throw std::logic_error("memory_twin: the twin's arrays differ from collide/eval/traffic.hpp's count");
   }
   return a;
 }

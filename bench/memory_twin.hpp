@@ -16,7 +16,7 @@
 // swept over the same range (the two index arrays through one value per
 // group: their cache lines are what costs) and the written arrays are
 // written once. What it moves
-// per collision is the model's bytes per collision (collide/traffic.hpp), so
+// per collision is the model's bytes per collision (collide/eval/traffic.hpp), so
 // kernel GB/s over twin GB/s is the fraction of the layout's own ceiling that
 // the arithmetic leaves.
 //

@@ -1,5 +1,5 @@
 // bench/packed_twin.hpp - the memory-only twin of a packed solve on a
-// scattered scene (issue 11): the ceiling of the packed layout with the
+// scattered scene: the ceiling of the packed layout with the
 // debris index pattern.
 //
 // It does what Solver::solve does on the caller's packed records, minus the

@@ -6,7 +6,7 @@
 // granularity add.
 #include "support.hpp"
 
-#include "collide/bandwidth.hpp"
+#include "collide/eval/bandwidth.hpp"
 
 #include <algorithm>
 #include <cstdint>

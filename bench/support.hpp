@@ -29,7 +29,7 @@
 #include <string>
 
 #include "collide/contacts.hpp"
-#include "collide/traffic.hpp"
+#include "collide/eval/traffic.hpp"
 
 namespace collide_bench {
 

@@ -1,11 +1,11 @@
 // bench/textbook.hpp - the baseline: the loop a user would write from the law.
 //
-// The loop itself lives in kernel/src/report/textbook.hpp, shared with `collide
+// The loop itself lives in eval/src/report/textbook.hpp, shared with `collide
 // report` (its textbook rows), so that the benchmarks and the report measure
 // the same baseline. This header keeps the benchmarks' name for it.
 #pragma once
 
-#include "../kernel/src/report/textbook.hpp"
+#include "../eval/src/report/textbook.hpp"
 
 namespace collide_bench {
 

@@ -2,7 +2,7 @@
 //
 // Design notes
 // ------------
-// The triad is the library's (collide::TriadArrays, collide/bandwidth.hpp:
+// The triad is the library's (collide::TriadArrays, collide/eval/bandwidth.hpp:
 // c[i] = a[i] + s * b[i] over float arrays of at least four times the
 // last-level cache each, 12 bytes counted per element as STREAM counts them,
 // one contiguous slice per thread, first-touched with the same slicing), the
@@ -15,7 +15,7 @@
 #include <cstddef>
 #include <string>
 
-#include "collide/bandwidth.hpp"
+#include "collide/eval/bandwidth.hpp"
 #include "support.hpp"
 
 namespace collide_bench {
@@ -23,7 +23,7 @@ namespace collide_bench {
 namespace {
 
 void triad_benchmark(benchmark::State& state, int threads) {
-  // The library's triad (collide/bandwidth.hpp), the one `collide report`
+  // The library's triad (collide/eval/bandwidth.hpp), the one `collide report`
   // uses; here its passes are timed by the benchmark loop.
   collide::TriadArrays triad(threads, collide::default_triad_array_bytes());
   double seconds = 0;

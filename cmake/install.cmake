@@ -2,22 +2,28 @@
 #
 # Design notes
 # ------------
-# * One library, static by default, shared with -DBUILD_SHARED_LIBS=ON (CMake's
-#   own switch, read by add_library in kernel/CMakeLists.txt).
+# * Three libraries, one package: the core collide::collide and the
+#   components io (collide::io) and eval (collide::eval), each static by
+#   default, shared with -DBUILD_SHARED_LIBS=ON (CMake's own switch).
+#   find_package(collide COMPONENTS io eval) asks for the components; the
+#   core alone needs neither (and a build with -DCOLLIDE_BUILD_IO=OFF installs
+#   the core alone).
 # * What a consumer needs is exactly the public link interface:
 #     - the headers (C++17, no TBB, no Eigen: both are used only in .cpp files);
-#     - for a static archive, TBB and libdeflate as well, because an archive
-#       cannot carry its own dependencies. The exported target says so
+#     - for a static archive, TBB (and for io, libdeflate) as well, because an
+#       archive cannot carry its own dependencies. The exported targets say so
 #       ($<LINK_ONLY:TBB::tbb>, $<LINK_ONLY:PkgConfig::LIBDEFLATE>, which CMake
 #       adds for a PRIVATE dependency of a static library), so the config file
 #       calls find_dependency(TBB) and finds libdeflate through pkg-config in
 #       that case only.
 #       Eigen never reaches the interface (it is a $<BUILD_INTERFACE>
 #       dependency).
-# * Three ways in, one target name: find_package(collide) and add_subdirectory
-#   both give collide::collide; pkg-config gives collide.pc, whose -ltbb -ldeflate sit in
-#   Libs.private for a static install (`pkg-config --static`), as pkg-config
-#   intends private dependencies to be spelled.
+# * Three ways in, the same names: find_package(collide) and add_subdirectory
+#   both give collide::collide, collide::io and collide::eval; pkg-config gives
+#   collide.pc, collide-io.pc and collide-eval.pc (each Requires the one below
+#   it), whose -ltbb, -ldeflate and -lquadmath sit in Libs.private for a static
+#   install (`pkg-config --static`), as pkg-config intends private
+#   dependencies to be spelled.
 # * The .pc file locates its prefix from its own directory (${pcfiledir}), so
 #   `cmake --install build --prefix anywhere` gives a working file without
 #   reconfiguring.
@@ -30,18 +36,31 @@ option(COLLIDE_INSTALL "Generate the install rules for collide" ${PROJECT_IS_TOP
 
 get_target_property(COLLIDE_LIBRARY_TYPE collide TYPE)
 
-# A static archive is often linked into a consumer's shared library, which
-# needs position-independent code; the kernels lose nothing measurable by it on
-# x86-64 (RIP-relative addressing). A caller's CMAKE_POSITION_INDEPENDENT_CODE
-# wins.
-if(NOT DEFINED CMAKE_POSITION_INDEPENDENT_CODE)
-  set_target_properties(collide PROPERTIES POSITION_INDEPENDENT_CODE ON)
+# The libraries of this build, and their export names (collide::<name>).
+set(COLLIDE_PACKAGE_LIBRARIES collide)
+if(TARGET collide_io)
+  list(APPEND COLLIDE_PACKAGE_LIBRARIES collide_io)
+  set_target_properties(collide_io PROPERTIES EXPORT_NAME io)
 endif()
-# 0.x: a minor release may break the ABI, so the soname carries major.minor.
-set_target_properties(collide PROPERTIES
-  VERSION ${PROJECT_VERSION}
-  SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR}
-  EXPORT_NAME collide)
+if(TARGET collide_eval)
+  list(APPEND COLLIDE_PACKAGE_LIBRARIES collide_eval)
+  set_target_properties(collide_eval PROPERTIES EXPORT_NAME eval)
+endif()
+set_target_properties(collide PROPERTIES EXPORT_NAME collide)
+
+foreach(lib IN LISTS COLLIDE_PACKAGE_LIBRARIES)
+  # A static archive is often linked into a consumer's shared library, which
+  # needs position-independent code; the kernels lose nothing measurable by
+  # it on x86-64 (RIP-relative addressing). A caller's
+  # CMAKE_POSITION_INDEPENDENT_CODE wins.
+  if(NOT DEFINED CMAKE_POSITION_INDEPENDENT_CODE)
+    set_target_properties(${lib} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  endif()
+  # 0.x: a minor release may break the ABI, so the soname carries major.minor.
+  set_target_properties(${lib} PROPERTIES
+    VERSION ${PROJECT_VERSION}
+    SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+endforeach()
 
 if(NOT COLLIDE_INSTALL)
   return()
@@ -49,12 +68,12 @@ endif()
 
 set(COLLIDE_CMAKE_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/collide)
 
-install(TARGETS collide EXPORT collideTargets
+install(TARGETS ${COLLIDE_PACKAGE_LIBRARIES} EXPORT collideTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-# collide/report.hpp belongs to the report engine (collide_report, not
+# report.hpp belongs to the report engine (collide_report, not
 # installed: it links Eigen and optionally Bullet), so it is left out.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/kernel/include/collide
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
@@ -81,6 +100,17 @@ if(COLLIDE_LIBRARY_TYPE STREQUAL "STATIC_LIBRARY")
   set(COLLIDE_NEEDS_TBB ON)
 else()
   set(COLLIDE_NEEDS_TBB OFF)
+endif()
+set(COLLIDE_NEEDS_DEFLATE OFF)
+if(COLLIDE_NEEDS_TBB AND TARGET collide_io)
+  set(COLLIDE_NEEDS_DEFLATE ON)
+endif()
+set(COLLIDE_COMPONENTS "")
+if(TARGET collide_io)
+  list(APPEND COLLIDE_COMPONENTS io)
+endif()
+if(TARGET collide_eval)
+  list(APPEND COLLIDE_COMPONENTS eval)
 endif()
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/collideConfig.cmake.in
   ${PROJECT_BINARY_DIR}/package/collideConfig.cmake
@@ -110,7 +140,11 @@ else()
   set(COLLIDE_PC_INCLUDEDIR "\${prefix}/${CMAKE_INSTALL_INCLUDEDIR}")
 endif()
 
-set(COLLIDE_PC_LIBS_PRIVATE "")
+# Libs.private of a static install: what each archive needs beyond the ones
+# its Requires names.
+set(_collide_pc_tbb "")
+set(_collide_pc_quadmath "")
+set(_collide_pc_deflate "")
 if(COLLIDE_NEEDS_TBB)
   # -L only when TBB is not in a directory the linker searches anyway.
   get_target_property(_collide_tbb_location TBB::tbb IMPORTED_LOCATION_RELEASE)
@@ -120,19 +154,39 @@ if(COLLIDE_NEEDS_TBB)
   if(_collide_tbb_location)
     get_filename_component(_collide_tbb_dir ${_collide_tbb_location} DIRECTORY)
     if(NOT _collide_tbb_dir IN_LIST CMAKE_CXX_IMPLICIT_LINK_DIRECTORIES)
-      string(APPEND COLLIDE_PC_LIBS_PRIVATE "-L${_collide_tbb_dir} ")
+      string(APPEND _collide_pc_tbb "-L${_collide_tbb_dir} ")
     endif()
   endif()
-  string(APPEND COLLIDE_PC_LIBS_PRIVATE "-ltbb")
-  # libdeflate: the .npz writer's CRC-32 (kernel/CMakeLists.txt); its own
-  # pkg-config flags, which carry a -L where it is not in the linker's path.
-  list(JOIN LIBDEFLATE_LDFLAGS " " _collide_deflate_flags)
-  string(APPEND COLLIDE_PC_LIBS_PRIVATE " ${_collide_deflate_flags}")
-  # libquadmath: the __float128 reference's sqrtq (kernel/CMakeLists.txt);
-  # GCC's own runtime, in the linker's default path.
+  string(APPEND _collide_pc_tbb "-ltbb")
+  # libquadmath: the __float128 buffers and reference (core, eval); GCC's own
+  # runtime, in the linker's default path.
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
-    string(APPEND COLLIDE_PC_LIBS_PRIVATE " -lquadmath")
+    set(_collide_pc_quadmath "-lquadmath")
+  endif()
+  # libdeflate: the .npz writer's CRC-32 (io); its own pkg-config flags, which
+  # carry a -L where it is not in the linker's path.
+  if(TARGET collide_io)
+    list(JOIN LIBDEFLATE_LDFLAGS " " _collide_pc_deflate)
   endif()
 endif()
-configure_file(${CMAKE_CURRENT_LIST_DIR}/collide.pc.in ${PROJECT_BINARY_DIR}/package/collide.pc @ONLY)
-install(FILES ${PROJECT_BINARY_DIR}/package/collide.pc DESTINATION ${COLLIDE_PC_DIR})
+
+# collide_pc_file(<file> <name> <description> <library> <requires> <libs.private>)
+function(collide_pc_file file name description library requires libs_private)
+  set(COLLIDE_PC_NAME "${name}")
+  set(COLLIDE_PC_DESCRIPTION "${description}")
+  set(COLLIDE_PC_LIBRARY "${library}")
+  set(COLLIDE_PC_REQUIRES "${requires}")
+  set(COLLIDE_PC_LIBS_PRIVATE "${libs_private}")
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/collide.pc.in ${PROJECT_BINARY_DIR}/package/${file} @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/package/${file} DESTINATION ${COLLIDE_PC_DIR})
+endfunction()
+collide_pc_file(collide.pc collide "${PROJECT_DESCRIPTION}" collide ""
+                "${_collide_pc_tbb} ${_collide_pc_quadmath}")
+if(TARGET collide_io)
+  collide_pc_file(collide-io.pc collide-io "collide scene files (CSV, .npz) and scene generators" collide_io
+                  "collide = ${PROJECT_VERSION}" "${_collide_pc_tbb} ${_collide_pc_deflate}")
+endif()
+if(TARGET collide_eval)
+  collide_pc_file(collide-eval.pc collide-eval "collide reference solver, error measures and hard scenes" collide_eval
+                  "collide-io = ${PROJECT_VERSION}" "${_collide_pc_tbb} ${_collide_pc_quadmath}")
+endif()

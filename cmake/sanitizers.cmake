@@ -1,4 +1,4 @@
-# cmake/sanitizers.cmake - sanitizer builds (issue 6), included from the top-level
+# cmake/sanitizers.cmake - sanitizer builds, included from the top-level
 # CMakeLists.txt before any target exists, so the options reach every target
 # of the project: the library, the CLI, the tests, the benchmarks and the
 # fuzzers.
@@ -54,7 +54,7 @@ if(COLLIDE_SANITIZE)
     set_target_properties(collide_itt_tsan PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR})
     # The negative control: a deliberate race TSan must report (not a ctest test).
     add_executable(collide_race_canary ${PROJECT_SOURCE_DIR}/tests/tsan/race_canary.cpp)
-    target_link_libraries(collide_race_canary PRIVATE collide TBB::tbb)
+    target_link_libraries(collide_race_canary PRIVATE collide collide_io TBB::tbb)
     set_target_properties(collide_race_canary PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR})
   endif()
   unset(_collide_sanitize)

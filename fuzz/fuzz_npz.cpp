@@ -26,8 +26,8 @@
 #include <string_view>
 #include <vector>
 
-#include "collide/npz.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/io/npz.hpp"
+#include "collide/io/scene_io.hpp"
 
 namespace {
 

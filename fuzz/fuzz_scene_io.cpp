@@ -23,7 +23,7 @@
 #include <string>
 #include <string_view>
 
-#include "collide/scene_io.hpp"
+#include "collide/io/scene_io.hpp"
 
 namespace {
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # CI, after the README's test command (.ci/run): the sanitized and fuzzed runs
-# of issue 6. Any finding fails the run (non-zero exit).
+# (sanitizers, fuzzers, the race detector). Any finding fails the run (non-zero exit).
 #
 #   1. ASan + UBSan: one Clang build (no Python module: a sanitized extension
 #      cannot load into an unsanitized interpreter; Debug, so the kernels' asserts are on,
@@ -98,7 +98,7 @@ set +e
 canary=$?
 set -e
 if [ "$canary" -ne 66 ] || ! grep -q "WARNING: ThreadSanitizer: data race" "$tsan/race_canary.log" ||
-  ! grep -q "kernel/src/" "$tsan/race_canary.log"; then
+  ! grep -q "core/src/" "$tsan/race_canary.log"; then
   echo "race_canary: TSan did not report the deliberate race in the kernel (exit $canary); the TSan run proves nothing" >&2
   tail -n 40 "$tsan/race_canary.log" >&2
   exit 1

@@ -1,4 +1,4 @@
-"""Call overhead of the Python module over the C++ solve (issue 14's targets).
+"""Call overhead of the Python module over the C++ solve.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python/bench_overhead.py [--quick]
 
@@ -12,7 +12,7 @@ restored before each call, untimed. Per call:
     overhead = wall - kernel_seconds   (checks, model choice, stats dict, GIL)
     ratio    = overhead / kernel_seconds
 
-and the table shows medians. Targets (issue 14), checked at the end:
+and the table shows medians. Targets, checked at the end:
     * ratio <= 5% at 1M pairs, for the frame-loop call;
     * overhead <= 20 us per call at 1k contacts, for the default (checked) call.
 

@@ -28,7 +28,7 @@
 //   Rigid records hold no inverse mass: it is a second caller's array, (N,)
 //   beside the records (PackedView<PackedRigid<T>>::inv_mass), checked like
 //   any array argument and only read by the solve.
-// * The statistics dict is collide::solve_record (collide/check.hpp), the
+// * The statistics dict is collide::solve_record (collide/eval/check.hpp), the
 //   record `collide solve --stats` prints, and the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises.
 #include <pybind11/numpy.h>
@@ -51,18 +51,18 @@
 #include <variant>
 #include <vector>
 
-#include "collide/check.hpp"
-#include "collide/error_bound.hpp"
-#include "collide/generate.hpp"
+#include "collide/eval/check.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/packed.hpp"
-#include "collide/reference.hpp"
-#include "collide/report.hpp"
+#include "collide/eval/reference.hpp"
+#include "report.hpp"
 #include "collide/rules.hpp"
-#include "collide/scene.hpp"
-#include "collide/scene_io.hpp"
-#include "collide/scene_npz.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
+#include "collide/io/scene_npz.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/validate.hpp"

@@ -26,8 +26,8 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/scene.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 

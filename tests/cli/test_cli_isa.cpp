@@ -1,8 +1,8 @@
 // test_cli_isa.cpp - `collide solve --isa` and COLLIDE_ISA through the real
-// CLI (issue 12): every ISA this CPU has writes the same bytes and says which
+// CLI: every ISA this CPU has writes the same bytes and says which
 // ran in --stats, and how it was chosen; an unknown or unsupported ISA is a
 // usage error that writes nothing. The same holds for --accuracy accurate
-// (issue 13), on every ISA.
+//, on every ISA.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -136,7 +136,7 @@ TEST_F(CliIsaTest, UnknownOrUnsupportedIsaIsAUsageErrorAndWritesNothing) {
   }
 }
 
-// The accurate mode (issue 13) runs on the same dispatch: the same bytes on
+// The accurate mode runs on the same dispatch: the same bytes on
 // every ISA, path and thread count, its name in --stats, and its bytes differ
 // from the fast mode's somewhere (it is not silently the fast mode).
 TEST_F(CliIsaTest, AccurateModeWritesTheSameBytesOnEveryIsaPathAndThreadCount) {

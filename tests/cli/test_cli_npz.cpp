@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/error_bound.hpp"
-#include "collide/npz.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/io/npz.hpp"
+#include "collide/io/scene_io.hpp"
 #include "support/mini_json.hpp"
 #include "support/run_cli.hpp"
 

@@ -1,6 +1,6 @@
 // test_cli_outputs.cpp - where `collide solve` writes its results: regular
 // files (renamed temporaries), stdout ("-"), character devices and FIFOs
-// (written in place, never replaced) - collide/output_file.hpp.
+// (written in place, never replaced) - collide/io/output_file.hpp.
 //
 // What this proves
 // ----------------

@@ -34,8 +34,8 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/bandwidth.hpp"
-#include "collide/error_bound.hpp"
+#include "collide/eval/bandwidth.hpp"
+#include "collide/eval/error_bound.hpp"
 #include "collide/isa.hpp"
 #include "support/mini_json.hpp"
 #include "support/report_run.hpp"
@@ -188,7 +188,7 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
             expected.insert({scene, friction, "scalar", precision, model, threads, "sse2"});
             expected.insert(
                 {scene, friction, "simd", precision, model, threads, collide::to_string(collide::default_isa())});
-            // ... in the fast and (issue 13) the accurate mode.
+            // ... in the fast and the accurate mode.
             expected.insert(
                 {scene, friction, "accurate", precision, model, threads, collide::to_string(collide::default_isa())});
           }
@@ -268,7 +268,7 @@ TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
 
 TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
   ASSERT_TRUE(report_->json.has("rows"));
-  // The accurate variant (issue 13) on independent pairs: J within 8 ulps
+  // The accurate variant on independent pairs: J within 8 ulps
   // of the long double reference, which judges float exactly enough; and
   // never less accurate than the fast SIMD row of the same scene.
   std::size_t checked = 0;

@@ -1,4 +1,4 @@
-// test_report_hard.cpp - `collide report --hard` as a user runs it (issue 13).
+// test_report_hard.cpp - `collide report --hard` as a user runs it.
 //
 // One small run (`--quick --n 2000 --threads 1 --hard --hard-n 200 --json
 // --plot`) is shared by the tests of this file:
@@ -26,10 +26,10 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/check.hpp"
-#include "collide/hard_scenes.hpp"
+#include "collide/eval/check.hpp"
+#include "collide/eval/hard_scenes.hpp"
 #include "collide/model.hpp"
-#include "collide/reference.hpp"  // COLLIDE_HAS_FLOAT128
+#include "collide/eval/reference.hpp"  // COLLIDE_HAS_FLOAT128
 #include "support/mini_json.hpp"
 #include "support/report_run.hpp"
 #include "support/run_cli.hpp"

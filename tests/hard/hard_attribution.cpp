@@ -1,5 +1,5 @@
 // hard_attribution.cpp - where the fast mode's impulse error comes from, per
-// hard family and per term of the law (issue 13, item 1).
+// hard family and per term of the law.
 //
 // Usage: hard_attribution [count]   (built with the tests, run by hand)
 //
@@ -34,7 +34,7 @@
 // the scene's model) for comparison: they agree to the digits shown, which
 // checks that the tool replicates the kernel. Errors are in the law's unit,
 // eps(T) times the impulse scale of reference_solve<__float128>
-// (impulse_error_unit in collide/error_bound.hpp), max over the scene.
+// (impulse_error_unit in collide/eval/error_bound.hpp), max over the scene.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -43,10 +43,10 @@
 #include <type_traits>
 #include <vector>
 
-#include "collide/error_bound.hpp"
-#include "collide/generate.hpp"
-#include "collide/hard_scenes.hpp"
-#include "collide/reference.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/io/generate.hpp"
+#include "collide/eval/hard_scenes.hpp"
+#include "collide/eval/reference.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "contact_kernel.hpp"

@@ -8,7 +8,7 @@
 // * the two paths give identical bytes;
 // * no NaN or inf in any impulse or velocity;
 // * no contact is above kImpulseErrorTargetEps (2) units, the fast mode's
-//   target (issue 13; a family still above it passes the bound as its
+//   target (a family still above it passes the bound as its
 //   target and says so), and a fortiori every contact satisfies
 //   |J - Jref| <= kImpulseErrorBoundEps * eps(T) *
 //   impulse_scale, Jref and impulse_scale from reference_solve<long double>
@@ -32,10 +32,10 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/hard_scenes.hpp"
+#include "collide/eval/hard_scenes.hpp"
 #include "collide/model.hpp"
-#include "collide/reference.hpp"
-#include "collide/scene.hpp"
+#include "collide/eval/reference.hpp"
+#include "collide/io/scene.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "support/error_bound.hpp"
@@ -192,7 +192,7 @@ void run_scene(const std::string& family, const Scene<T>& scene, const BodyBuffe
     report(family, precision, model, st);
     EXPECT_EQ(st.over, 0u) << st.over << " contacts over the bound; worst contact " << st.worst << " at "
                            << static_cast<double>(st.max) << " eps * impulse_scale";
-    // The fast mode's target, tighter than the bound (collide/error_bound.hpp).
+    // The fast mode's target, tighter than the bound (collide/eval/error_bound.hpp).
     EXPECT_LE(st.max, target) << "worst contact " << st.worst << " at " << static_cast<double>(st.max)
                               << " eps * impulse_scale, above the target";
     EXPECT_GE(st.acting, min_acting) << "too few contacts act: the family degenerated";

@@ -9,7 +9,7 @@
 // to them; rerun this only when a family or the law changes.
 //
 // Why the fixtures look the way they do:
-// * The scenes are the hard-case families of collide/hard_scenes.hpp drawn in
+// * The scenes are the hard-case families of collide/eval/hard_scenes.hpp drawn in
 //   float and written exactly (shortest round trip of the float value, read
 //   back as double it is the same number), so the file means the same scene
 //   to a float and a double run (q and n are stored as read; the law
@@ -19,7 +19,7 @@
 //   `collide solve --precision double` reads it (read_bodies, to_body_buffer,
 //   read_contacts), rounded to double and written with scene_io's writers.
 // * The families are those whose scenes currently meet the documented bound
-//   (see the issue 6 report for the ones that do not); 60 to 200 contacts
+//   (docs/collision-law.md lists the ones that do not); 60 to 200 contacts
 //   each, so the files stay small.
 #include <cstdio>
 #include <exception>
@@ -29,10 +29,10 @@
 #include <utility>
 #include <vector>
 
-#include "collide/hard_scenes.hpp"
-#include "collide/reference.hpp"
-#include "collide/scene.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/eval/hard_scenes.hpp"
+#include "collide/eval/reference.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
 
 namespace {
 

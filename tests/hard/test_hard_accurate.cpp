@@ -1,9 +1,9 @@
 // test_hard_accurate.cpp - the accurate mode (collide::Accuracy::accurate) on
-// every hard family (issue 13).
+// every hard family.
 //
 // What this proves
 // ----------------
-// For every single-contact family of collide/hard_scenes.hpp (mass ratios 1e+-8,
+// For every single-contact family of collide/eval/hard_scenes.hpp (mass ratios 1e+-8,
 // immovable bodies, needles with moment ratios 1e-12, levers 1e4, grazing
 // vn/|u| down to 1e-7, unit scales, subnormal speeds, separating/resting,
 // e = 0 and 1, stick/slip, spin-dominated) and the shared-body scenes
@@ -41,8 +41,8 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/check.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/eval/check.hpp"
+#include "collide/io/scene_io.hpp"
 #include "hard/hard_check.hpp"
 #if defined(COLLIDE_CLI_PATH)
 #include <charconv>

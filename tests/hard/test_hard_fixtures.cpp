@@ -33,10 +33,10 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/error_bound.hpp"
-#include "collide/reference.hpp"
-#include "collide/scene.hpp"
-#include "collide/scene_io.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/eval/reference.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
 #include "support/error_bound.hpp"
 
 namespace collide {
@@ -144,7 +144,7 @@ void check_fixture(const fs::path& dir) {
 
   // Impulses: finite, within the bound of this run's reference and of the
   // committed expectation. The unit is the library's: eps(T) *
-  // impulse_scale plus the underflow floor (collide/error_bound.hpp).
+  // impulse_scale plus the underflow floor (collide/eval/error_bound.hpp).
   L worst = 0, worst_expected = 0, input_rounding = 0;
   for (std::size_t k = 0; k < n; ++k) {
     for (const L x : j[k]) ASSERT_TRUE(std::isfinite(x)) << "contact " << k;

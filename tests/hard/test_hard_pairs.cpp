@@ -1,8 +1,8 @@
-// test_hard_pairs.cpp - the single-contact hard-case families of issue 6.
+// test_hard_pairs.cpp - the single-contact hard-case families.
 //
 // What this proves
 // ----------------
-// For each family of collide/hard_scenes.hpp - extreme mass ratios, immovable
+// For each family of collide/eval/hard_scenes.hpp - extreme mass ratios, immovable
 // bodies, needle-thin inertia struck at the tip, long lever arms, grazing
 // approach, extreme unit scales, subnormal speeds, exactly separating and
 // exactly resting contacts, e = 0 and e = 1, friction at the stick/slip

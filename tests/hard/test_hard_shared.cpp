@@ -1,4 +1,4 @@
-// test_hard_shared.cpp - hard cases where contacts share bodies (issue 6).
+// test_hard_shared.cpp - hard cases where contacts share bodies.
 //
 // What this proves
 // ----------------

@@ -29,17 +29,35 @@ function(fresh_dir dir)
 endfunction()
 
 # Checks that the files a consumer relies on are installed in `prefix`.
-function(check_installed prefix library_type)
+# `components` is "all" (core, io, eval) or "core" (and then io and eval must
+# be absent).
+function(check_installed prefix library_type components)
   set(files
     include/collide/solve.hpp
     lib/cmake/collide/collideConfig.cmake
     lib/cmake/collide/collideConfigVersion.cmake
     lib/cmake/collide/collideTargets.cmake
     lib/pkgconfig/collide.pc)
+  set(component_files
+    include/collide/io/scene_npz.hpp
+    include/collide/eval/reference.hpp
+    lib/pkgconfig/collide-io.pc
+    lib/pkgconfig/collide-eval.pc)
   if(library_type STREQUAL "STATIC_LIBRARY")
     list(APPEND files lib/libcollide.a)
+    list(APPEND component_files lib/libcollide_io.a lib/libcollide_eval.a)
   else()
     list(APPEND files lib/libcollide.so)
+    list(APPEND component_files lib/libcollide_io.so lib/libcollide_eval.so)
+  endif()
+  if(components STREQUAL "all")
+    list(APPEND files ${component_files})
+  else()
+    foreach(f IN LISTS component_files)
+      if(EXISTS ${prefix}/${f})
+        message(FATAL_ERROR "the core alone installed ${prefix}/${f}")
+      endif()
+    endforeach()
   endif()
   foreach(f IN LISTS files)
     if(NOT EXISTS ${prefix}/${f})
@@ -73,7 +91,9 @@ function(build_and_run_consumer dir)
 endfunction()
 
 # Compiles the consumer with the flags pkg-config gives for `prefix`, runs it.
-function(pkg_config_consumer prefix library_type dir)
+# `module` is collide-eval (the consumer with every component) or collide (the
+# core alone).
+function(pkg_config_consumer prefix library_type dir module)
   if(NOT PKG_CONFIG)
     message(FATAL_ERROR "pkg-config not found (scripts/install-deps.sh installs it)")
   endif()
@@ -87,10 +107,14 @@ function(pkg_config_consumer prefix library_type dir)
   else()
     set(rpath -Wl,-rpath,${prefix}/lib)
   endif()
-  run("pkg-config" ENV ${env} COMMAND ${PKG_CONFIG} ${static} --cflags --libs collide)
+  run("pkg-config" ENV ${env} COMMAND ${PKG_CONFIG} ${static} --cflags --libs ${module})
   string(STRIP "${last_output}" flags)
   separate_arguments(flags UNIX_COMMAND "${flags}")
-  run("compile with pkg-config flags" COMMAND ${CXX} -std=c++17 -O2 -Wall -Wextra -Wpedantic -Werror
+  set(defs "")
+  if(module STREQUAL "collide")
+    set(defs -DCOLLIDE_CONSUMER_CORE_ONLY)
+  endif()
+  run("compile with pkg-config flags" COMMAND ${CXX} -std=c++17 -O2 -Wall -Wextra -Wpedantic -Werror ${defs}
       ${CONSUMER_DIR}/main.cpp -o ${dir}/consumer ${flags} ${rpath})
   run("run consumer" COMMAND ${dir}/consumer)
   message(STATUS "${last_output}")
@@ -101,34 +125,50 @@ file(MAKE_DIRECTORY ${WORK_DIR})
 if(MODE STREQUAL "install")
   file(REMOVE_RECURSE ${PREFIX})
   run("install" COMMAND ${CMAKE_COMMAND} --install ${BINARY_DIR} --prefix ${PREFIX} --config ${CONFIG})
-  check_installed(${PREFIX} ${LIBRARY_TYPE})
+  check_installed(${PREFIX} ${LIBRARY_TYPE} all)
 
 elseif(MODE STREQUAL "find_package")
   # Eigen3 is disabled for the consumer: a package that needed it would fail.
   build_and_run_consumer(${WORK_DIR}/find_package -DCMAKE_PREFIX_PATH=${PREFIX}
                          -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON)
+  # A component the package does not have is an error of find_package.
+  fresh_dir(${WORK_DIR}/find_package_missing)
+  file(WRITE ${WORK_DIR}/find_package_missing/CMakeLists.txt
+       "cmake_minimum_required(VERSION 3.16)\nproject(missing LANGUAGES CXX)\nfind_package(collide REQUIRED COMPONENTS nonesuch)\n")
+  execute_process(COMMAND ${CMAKE_COMMAND} -S ${WORK_DIR}/find_package_missing -B ${WORK_DIR}/find_package_missing/b
+                          -DCMAKE_PREFIX_PATH=${PREFIX} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "nonesuch")
+    message(FATAL_ERROR "find_package(collide COMPONENTS nonesuch) did not fail naming the component:\n${err}")
+  endif()
 
 elseif(MODE STREQUAL "pkg_config")
-  pkg_config_consumer(${PREFIX} ${LIBRARY_TYPE} ${WORK_DIR}/pkg_config)
+  pkg_config_consumer(${PREFIX} ${LIBRARY_TYPE} ${WORK_DIR}/pkg_config collide-eval)
+  # The core alone from the same install: `pkg-config collide` names no io or
+  # eval library.
+  pkg_config_consumer(${PREFIX} ${LIBRARY_TYPE} ${WORK_DIR}/pkg_config_core collide)
 
 elseif(MODE STREQUAL "add_subdirectory")
-  # The embedding project builds collide shared, then installs it from its own
-  # build (COLLIDE_INSTALL=ON) into a second prefix that find_package and
-  # pkg-config consume: the shared-library package, tested at the cost of one
-  # library build. That build has only the baseline kernel
-  # (COLLIDE_KERNEL_ISAS=sse2, as an embedding project may choose): this test
-  # is about the packaging, the per-ISA kernels are tested in the main build,
-  # and each one more would cost minutes of CI time.
+  # The embedding project builds the core alone (CONSUMER_CORE_ONLY turns
+  # io and eval off), shared, then installs it from its own build
+  # (COLLIDE_INSTALL=ON) into a second prefix that find_package and pkg-config
+  # consume: the core builds, installs and links without the other libraries,
+  # and the shared-library package is tested, at the cost of one core build.
+  # That build has only the baseline kernel (COLLIDE_KERNEL_ISAS=sse2, as an
+  # embedding project may choose): this test is about the packaging, the
+  # per-ISA kernels are tested in the main build, and each one more would
+  # cost minutes of CI time.
   set(dir ${WORK_DIR}/add_subdirectory)
   set(shared_prefix ${WORK_DIR}/shared-prefix)
-  build_and_run_consumer(${dir} -DCOLLIDE_SOURCE_DIR=${SOURCE_DIR} -DBUILD_SHARED_LIBS=ON -DCOLLIDE_INSTALL=ON
-                         -DCOLLIDE_KERNEL_ISAS=sse2)
+  build_and_run_consumer(${dir} -DCOLLIDE_SOURCE_DIR=${SOURCE_DIR} -DCONSUMER_CORE_ONLY=ON -DBUILD_SHARED_LIBS=ON
+                         -DCOLLIDE_INSTALL=ON -DCOLLIDE_KERNEL_ISAS=sse2)
   file(REMOVE_RECURSE ${shared_prefix})
   run("install shared collide" COMMAND ${CMAKE_COMMAND} --install ${dir} --prefix ${shared_prefix})
-  check_installed(${shared_prefix} SHARED_LIBRARY)
-  build_and_run_consumer(${WORK_DIR}/shared_find_package -DCMAKE_PREFIX_PATH=${shared_prefix}
+  check_installed(${shared_prefix} SHARED_LIBRARY core)
+  # Neither Eigen nor TBB (nor libdeflate) is needed by a consumer of the
+  # shared core.
+  build_and_run_consumer(${WORK_DIR}/shared_find_package -DCMAKE_PREFIX_PATH=${shared_prefix} -DCONSUMER_CORE_ONLY=ON
                          -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON)
-  pkg_config_consumer(${shared_prefix} SHARED_LIBRARY ${WORK_DIR}/shared_pkg_config)
+  pkg_config_consumer(${shared_prefix} SHARED_LIBRARY ${WORK_DIR}/shared_pkg_config collide)
 
 else()
   message(FATAL_ERROR "unknown MODE '${MODE}'")

@@ -3,7 +3,7 @@
 //
 // The tests do not depend on the library's generator (generate.cpp): every
 // scene here is drawn with std::mt19937_64 from a seed (the draws of
-// collide/hard_scenes.hpp, which the hard families share) and pushed through
+// collide/eval/hard_scenes.hpp, which the hard families share) and pushed through
 // the public BodyBuffer / ContactBuffer API, so a test failure can always be
 // reproduced from the seed printed with it.
 //
@@ -27,12 +27,12 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/hard_scenes.hpp"
-#include "collide/scene.hpp"
+#include "collide/eval/hard_scenes.hpp"
+#include "collide/io/scene.hpp"
 
 namespace collide::test {
 
-/// The library's draws (collide/hard_scenes.hpp): the hard families and
+/// The library's draws (collide/eval/hard_scenes.hpp): the hard families and
 /// these scenes are made of the same bodies and contacts.
 using Rng = SceneRng;
 

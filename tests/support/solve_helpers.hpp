@@ -16,7 +16,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/reference.hpp"
+#include "collide/eval/reference.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 

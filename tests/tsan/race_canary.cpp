@@ -18,7 +18,7 @@
 
 #include <oneapi/tbb/global_control.h>
 
-#include "collide/scene.hpp"
+#include "collide/io/scene.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 

@@ -1,24 +1,32 @@
 // A C++17 program that uses collide the way an embedding project does.
 //
 // Built four ways by tests/package/: in the collide build tree, against an
-// installed package through find_package(collide), through
-// add_subdirectory(collide), and with the flags of `pkg-config collide`. It
-// includes every public header under -std=c++17 -Wall -Wextra -Wpedantic
-// -Werror, so a C++20-only construct or a warning in a header fails the build,
-// and it runs a scene whose answer is known exactly, so a library that links
-// but misbehaves (a missing TBB, a wrong instantiation) fails the run.
+// installed package through find_package(collide COMPONENTS io eval), through
+// add_subdirectory(collide), and with the flags of `pkg-config collide-eval`.
+// It is compiled under -std=c++17 -Wall -Wextra -Wpedantic -Werror, so a
+// C++20-only construct or a warning in a header fails the build, and it runs
+// a scene whose answer is known exactly, so a library that links but
+// misbehaves (a missing TBB, a wrong instantiation) fails the run.
+//
+// With COLLIDE_CONSUMER_CORE_ONLY it includes and links the core alone
+// (collide::collide, `pkg-config collide`), the way a project that brings its
+// own scenes embeds the solver: the core must build, install and link without
+// the io and eval libraries.
+#include <collide/accuracy.hpp>
 #include <collide/bodies.hpp>
 #include <collide/contacts.hpp>
-#include <collide/error_bound.hpp>
-#include <collide/generate.hpp>
 #include <collide/isa.hpp>
 #include <collide/model.hpp>
-#include <collide/reference.hpp>
-#include <collide/scene.hpp>
-#include <collide/scene_io.hpp>
 #include <collide/schedule.hpp>
 #include <collide/solve.hpp>
 #include <collide/validate.hpp>
+#if !defined(COLLIDE_CONSUMER_CORE_ONLY)
+#include <collide/eval/error_bound.hpp>
+#include <collide/eval/reference.hpp>
+#include <collide/io/generate.hpp>
+#include <collide/io/scene.hpp>
+#include <collide/io/scene_io.hpp>
+#endif
 
 #include <cmath>
 #include <cstdio>
@@ -93,8 +101,9 @@ void solve_caller_arrays() {
               collide::to_string(stats.model), stats.contacts, stats.batches, jx[0], jy[0], jz[0], jx[1], jy[1], jz[1]);
 }
 
+#if !defined(COLLIDE_CONSUMER_CORE_ONLY)
 // Owned buffers in double, the one-shot solve(), and the reference: exercises
-// the library's explicit instantiations and its TBB-backed scene generator.
+// the libraries' explicit instantiations and the TBB-backed scene generator.
 void solve_owned_buffers() {
   collide::Scene<double> scene = collide::generate_pairs<double>(1000, {});
   collide::Scene<double> copy = collide::convert_scene<double>(scene);
@@ -111,6 +120,7 @@ void solve_owned_buffers() {
   std::printf("owned buffers: %zu contacts on %zu lanes x %d threads, model %s, max |dJx| = %g\n", stats.contacts,
               stats.lanes, stats.threads, collide::to_string(stats.model), worst);
 }
+#endif
 
 }  // namespace
 
@@ -126,7 +136,11 @@ void check_kernels_built() {
 
 int main() {
   solve_caller_arrays();
+#if !defined(COLLIDE_CONSUMER_CORE_ONLY)
   solve_owned_buffers();
+#else
+  std::puts("consumer: the core alone");
+#endif
   check_kernels_built();
   if (failures != 0) return 1;
   std::puts("consumer: ok");

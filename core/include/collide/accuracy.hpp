@@ -1,0 +1,30 @@
+// collide/accuracy.hpp - what the kernels promise about their error.
+//
+// Two modes, two promises (docs/collision-law.md, "Error bounds"):
+//
+//   fast      |J - J_ref| <= kImpulseErrorBoundEps * eps(T) * impulse_scale
+//   accurate  |J - J_ref| <= kAccurateErrorUlps * (eps(T) |J_ref| + denorm_min(T))
+//
+// J_ref is the law evaluated exactly on the kernel's own inputs and
+// impulse_scale the contact's speed scale times its apparent mass (both
+// computed by the reference, collide/eval/reference.hpp, which also measures
+// the errors: collide/eval/error_bound.hpp, collide/eval/check.hpp). The
+// constants live in the core because the core's own decisions depend on them:
+// a smaller body model may leave out only terms below a quarter of the fast
+// bound (collide/model.hpp).
+#pragma once
+
+namespace collide {
+
+/// The documented bound on a fast-mode impulse error, in units of
+/// eps(T) * impulse_scale (plus an underflow floor; collide/eval/error_bound.hpp).
+inline constexpr double kImpulseErrorBoundEps = 64.0;
+
+/// What the accurate mode (SolverOptions::accuracy = Accuracy::accurate)
+/// promises: the plain relative error of every J within this many ulps of
+/// its precision, |J - Jref| <= kAccurateErrorUlps (eps(T) |Jref| +
+/// denorm_min(T)), Jref the exact law on the stored inputs
+/// (test_hard_accurate and `collide report --hard` check it).
+inline constexpr double kAccurateErrorUlps = 8.0;
+
+}  // namespace collide

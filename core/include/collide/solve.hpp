@@ -1,0 +1,246 @@
+// collide/solve.hpp - resolving a batch of contacts.
+//
+// Every contact is resolved by the law of docs/collision-law.md. The result
+// does not depend on the path, the SIMD width or the thread count: all paths
+// run the same kernel body (core/src/contact_kernel.hpp) with the same IEEE
+// operations in the same order and no fused multiply-add, so they agree bit
+// for bit. Contacts that share a movable body are applied in input order
+// (see schedule.hpp).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/packed.hpp"
+#include "collide/schedule.hpp"
+
+namespace collide {
+/// Which implementation of the kernel runs.
+enum class Path {
+  scalar,  ///< one contact at a time (lane width 1)
+  simd,    ///< SIMD lanes: 16 float / 8 double with AVX-512, 8 / 4 with AVX2, 4 / 2 with SSE2
+};
+
+const char* to_string(Path path);
+
+/// The body layout a solve runs on (collide/packed.hpp).
+enum class BodyLayout {
+  automatic,  ///< SoA input is packed when its contacts reach bodies at random (see Solver)
+  soa,        ///< the caller's SoA arrays, read and written in place
+  packed,     ///< packed records: the caller's, or SoA input packed into the solver's buffer
+};
+
+/// "auto", "soa" or "packed".
+const char* to_string(BodyLayout layout);
+
+/// How the law's cancellation-prone quantities are evaluated. Both modes
+/// compute the same law on the same paths, ISAs and thread counts, and each
+/// is bitwise identical across them; they differ from each other in the last
+/// bits (docs/collision-law.md, "Accuracy modes").
+enum class Accuracy {
+  fast,      ///< plain IEEE arithmetic in the working precision
+  accurate,  ///< the relative velocity, the lever arms and friction's u' free of cancellation
+};
+
+/// "fast" or "accurate".
+const char* to_string(Accuracy accuracy);
+/// Parses the names of to_string(); throws std::invalid_argument otherwise.
+Accuracy parse_accuracy(std::string_view name);
+
+struct SolverOptions {
+  Path path = Path::simd;
+  /// Worker threads; 0 means every hardware thread. Results do not depend on
+  /// it. Must be 0 for a solver running in the caller's arena (collide/tbb.hpp).
+  int threads = 0;
+  /// Contacts per parallel task inside a batch (rounded up to the lane
+  /// width). A batch of fewer than two blocks runs on the calling thread. A
+  /// task of 1024 contacts takes 10 to 50 us, far above TBB's per-task cost,
+  /// and lets the small batches of shared-body scenes (the debris scene's
+  /// batches are a few thousand contacts at 64k) still split across threads.
+  std::size_t block = 1024;
+  /// Instruction set of the SIMD path (collide/isa.hpp). A named one, or the
+  /// one COLLIDE_ISA names when this is automatic, is resolved when the
+  /// Solver is built (one the CPU lacks makes the constructor throw) and runs
+  /// every solve. automatic with COLLIDE_ISA unset picks per solve the ISA
+  /// that ran fastest on this CPU for the solve's model, precision, accuracy
+  /// and scene kind (fastest_isa()). Results never depend on it.
+  Isa isa = Isa::automatic;
+  Accuracy accuracy = Accuracy::fast;
+  /// For SoA input: automatic packs it when that is faster (Solver::solve),
+  /// soa never packs, packed always packs. Ignored for packed input.
+  BodyLayout layout = BodyLayout::automatic;
+};
+
+/// What a solve did.
+struct SolveStats {
+  std::size_t contacts = 0;       ///< contacts resolved (including those with J = 0)
+  std::size_t batches = 0;        ///< batches run one after another (Schedule::batch_count())
+  std::size_t largest_batch = 0;  ///< contacts in the largest batch (Schedule::largest_batch())
+  std::size_t conflicts = 0;      ///< dependencies the schedule respected (Schedule::conflicts())
+  std::size_t lanes = 0;          ///< SIMD width used for this precision
+  int threads = 0;                ///< threads available to the solve
+  Model model = Model::rigid;
+  Path path = Path::simd;
+  bool friction = false;                     ///< the Coulomb step ran (ContactView::mu was set)
+  Isa isa = Isa::sse2;                       ///< the instruction set that ran (never automatic)
+  IsaChoice isa_choice = IsaChoice::forced;  ///< how `isa` was chosen (collide/isa.hpp)
+  /// Time this solve spent measuring the ISAs for fastest_isa() [s]: the
+  /// first solve of its kind in the process with isa_choice measured pays
+  /// about a millisecond, every later one 0. Part of the solve's wall time.
+  double isa_calibration_seconds = 0;
+  BodyLayout layout = BodyLayout::soa;  ///< the layout the kernel ran on (never automatic)
+  Accuracy accuracy = Accuracy::fast;
+};
+
+/// Number of lanes of the SIMD path for T under default_isa() (COLLIDE_ISA,
+/// else the widest ISA). A solve whose ISA was measured (SolveStats::
+/// isa_choice) may run fewer: SolveStats::lanes says what it ran.
+template <class T>
+std::size_t simd_width();
+
+/// The ISA whose SIMD kernel ran fastest on this CPU for `model` in precision
+/// T (float or double) and `accuracy`, on a streaming scene (scattered =
+/// false: contact k joins bodies 2k and 2k+1, the SoA arrays in order) or a
+/// scattered one (scattered = true: contacts reach packed bodies at random,
+/// as in the debris scene). It is what a Solver with Isa::automatic and
+/// COLLIDE_ISA unset runs; a solve counts as scattered when most of its
+/// schedule's contacts are in non-contiguous batches.
+///
+/// Measured once per process at the first call for each key (thread-safe;
+/// later calls return the cached answer): every ISA the CPU has runs its
+/// kernel on one thread over a small synthetic scene in cache, round by
+/// round, and the fastest best time wins. That takes a millisecond or two
+/// (isa_measurement() says how long). With one ISA, nothing is measured.
+/// COLLIDE_ISA does not affect it.
+template <class T>
+Isa fastest_isa(Model model, Accuracy accuracy, bool scattered);
+
+/// What the measurement behind fastest_isa() found for one key.
+struct IsaMeasurement {
+  Isa fastest = Isa::sse2;  ///< fastest_isa() for the key
+  /// Contacts of each timed pass over the synthetic scene: up to 1024, fewer
+  /// for slow kernels (0: nothing was measured).
+  std::size_t contacts = 0;
+  int rounds = 0;                  ///< timed passes per ISA (after one warm-up pass)
+  double calibration_seconds = 0;  ///< wall time of the whole measurement [s]
+  /// The best time of one timed pass for sse2, avx2 and avx512 in that order
+  /// [s]; 0 for an ISA not measured (the CPU lacks it).
+  double seconds[3] = {0, 0, 0};
+};
+
+/// The measurement of fastest_isa(model, accuracy, scattered), run first if
+/// it has not run in this process yet.
+template <class T>
+IsaMeasurement isa_measurement(Model model, Accuracy accuracy, bool scattered);
+
+/// A caller's tbb::task_arena, defined in collide/tbb.hpp so that this header
+/// does not need TBB.
+struct ExternalArena;
+
+/// A reusable solver. It owns the worker threads (a tbb::task_arena), or runs
+/// in the caller's arena (collide/tbb.hpp), and allocates nothing while
+/// solving once its buffers are sized, so one Solver can run every frame.
+///
+/// SoA input whose contacts reach bodies at random (the schedule has
+/// non-contiguous batches covering at least a quarter as many contacts as
+/// there are bodies; SolverOptions::layout can force either way) is packed
+/// into the solver's own buffer, solved there, and v, w written back: the
+/// same bits as solving in place, several times faster on scattered scenes
+/// (README, "Performance"). The buffer grows to the largest scene seen and is
+/// kept; solves that pack on one Solver run one at a time. The only state
+/// shared between solvers is the process's cache of fastest_isa() answers:
+/// two solvers never share threads unless their caller shares an arena.
+class Solver {
+ public:
+  explicit Solver(const SolverOptions& options = {});
+  /// Runs every solve inside the caller's arena instead of owning one; the
+  /// arena must outlive the solver, and options.threads must be 0 (the
+  /// arena's concurrency is used). Prefer collide::make_solver(arena).
+  Solver(const ExternalArena& arena, const SolverOptions& options);
+  ~Solver();
+  Solver(const Solver&) = delete;
+  Solver& operator=(const Solver&) = delete;
+  Solver(Solver&&) noexcept;
+  Solver& operator=(Solver&&) noexcept;
+
+  [[nodiscard]] const SolverOptions& options() const;
+  /// The instruction set this solver's SIMD path runs when it is fixed:
+  /// options().isa, or the one COLLIDE_ISA named when that was automatic.
+  /// Isa::automatic when the choice is made per solve (isa_choice() is
+  /// measured): each solve's SolveStats::isa says which ISA ran.
+  [[nodiscard]] Isa isa() const;
+  /// How the ISA of this solver's SIMD solves is chosen: forced,
+  /// environment or measured (SolveStats::isa_choice, which is forced on the
+  /// scalar path: it always runs the baseline).
+  [[nodiscard]] IsaChoice isa_choice() const;
+
+  /// Resolves every contact: updates v and w of movable bodies and writes J.
+  /// Checked in every build type before anything is read or written
+  /// (std::invalid_argument naming the counts or the array): the schedule
+  /// was built for as many contacts and bodies as the views hold
+  /// (schedule.contact_count() == contacts.count, schedule.body_count() ==
+  /// bodies.count), impulses.count == contacts.count, and no array the
+  /// model reads is null while its count is > 0 (contacts.c may be null for
+  /// the particle model; e and mu are optional). Schedule::build checked
+  /// every index against the body count; the schedule must have been built
+  /// from these contacts' indices, unchanged since (a schedule is reused
+  /// while they do not change). Precondition, not checked here: the values
+  /// obey validate()'s rules (finite, unit normals and quaternions, e in
+  /// [0, 1], ...); values that do not may give NaN or inf but stay inside
+  /// the arrays.
+  template <class T>
+  SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+  /// The sphere model (see model.hpp for when it is the law).
+  template <class T>
+  SolveStats solve(const SphereView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+  /// The particle model (see model.hpp for when it is the law).
+  template <class T>
+  SolveStats solve(const ParticleView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                   const Schedule& schedule) const;
+  /// The same on packed bodies (collide/packed.hpp): the caller's records are
+  /// read and their v, w written in place; nothing is packed or unpacked.
+  template <class T>
+  SolveStats solve(const PackedView<PackedRigid<T>>& bodies, const ContactView<T>& contacts,
+                   const ImpulseView<T>& impulses, const Schedule& schedule) const;
+  template <class T>
+  SolveStats solve(const PackedView<PackedSphere<T>>& bodies, const ContactView<T>& contacts,
+                   const ImpulseView<T>& impulses, const Schedule& schedule) const;
+  template <class T>
+  SolveStats solve(const PackedView<PackedParticle<T>>& bodies, const ContactView<T>& contacts,
+                   const ImpulseView<T>& impulses, const Schedule& schedule) const;
+  /// Rigid bodies solved with `model`, which must fit them (model_misfit()
+  /// is empty; asserted in debug builds): the views of the smaller models
+  /// point into the same arrays, so nothing is copied.
+  template <class T>
+  SolveStats solve(Model model, const BodyView<T>& bodies, const ContactView<T>& contacts,
+                   const ImpulseView<T>& impulses, const Schedule& schedule) const;
+
+ private:
+  template <class Record, class View, class T>
+  SolveStats solve_soa(Model model, const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                       const Schedule& schedule) const;
+  template <class Record, class T>
+  SolveStats solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
+                          const ImpulseView<T>& impulses, const Schedule& schedule) const;
+
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-shot convenience: checks the input with validate() first, then builds
+/// a schedule and a solver and solves with the cheapest model that fits
+/// (choose_model()). Input that validate() rejects throws
+/// std::invalid_argument carrying validate()'s message ("collide::solve:
+/// contacts.b[17] = 40: out of range (8 bodies)") and nothing is written;
+/// options the Solver refuses throw as its constructor does.
+template <class T>
+SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                 const SolverOptions& options = {});
+
+}  // namespace collide

@@ -1,0 +1,372 @@
+// kernel_isa.cpp - the kernel for one instruction set: gathers contacts and
+// bodies into lanes, runs the kernel body of contact_kernel.hpp, scatters the
+// results. Compiled once per ISA (core/CMakeLists.txt) with
+// COLLIDE_KERNEL_NS naming it; kernel_table.hpp is the seam to the driver.
+//
+// Design notes
+// ------------
+// * A range is processed W contacts at a time; the last (count mod W)
+//   contacts run through the baseline object's one-lane kernel
+//   (solve_range_scalar). Same operations, same order, no FMA: the tail is
+//   bitwise what a lane would have produced, on every ISA.
+// * Contiguous batches (every scene without shared movable bodies, like the
+//   pairs scene) load contact fields as vectors; only the first index of
+//   each group is read from `order`.
+// * Immovable bodies are gathered but never written: many lanes may read the
+//   one ground body at once, none writes it.
+// * Nothing here allocates, spawns or locks: threads are the driver's
+//   (solve.cpp); this file is arithmetic and memory only.
+#include <algorithm>
+#include <cassert>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "contact_kernel.hpp"
+#include "kernel_table.hpp"
+#include "record_lanes.hpp"
+
+#ifndef COLLIDE_PREFETCH_AHEAD
+#define COLLIDE_PREFETCH_AHEAD 32
+#endif
+
+#ifndef COLLIDE_KERNEL_NS
+#error "kernel_isa.cpp is compiled once per ISA with COLLIDE_KERNEL_NS set (core/CMakeLists.txt)"
+#endif
+
+namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
+namespace {
+
+/// Where the W contacts of a group come from: consecutive indices starting at
+/// `first` (contiguous batch) or the W indices at `index`.
+struct ContactGroup {
+  bool contiguous;
+  std::uint32_t first;
+  const std::uint32_t* index;
+};
+
+template <class V, class T>
+COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
+  return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
+}
+
+/// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
+/// so that the index gather and the paired load share one field list.
+template <class M, class V, class View, class F>
+COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
+  f(view.inv_mass, a.inv_mass, b.inv_mass);
+  if constexpr (std::is_same_v<M, RigidModel>) {
+    f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
+    f(view.inv_inertia.y, a.inv_inertia.y, b.inv_inertia.y);
+    f(view.inv_inertia.z, a.inv_inertia.z, b.inv_inertia.z);
+    f(view.q.w, a.q.w, b.q.w);
+    f(view.q.x, a.q.x, b.q.x);
+    f(view.q.y, a.q.y, b.q.y);
+    f(view.q.z, a.q.z, b.q.z);
+    a.rotation = normalised_rotation(a.q);
+    b.rotation = normalised_rotation(b.q);
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
+  }
+  if constexpr (kRotates<M>) {
+    f(view.p.x, a.p.x, b.p.x);
+    f(view.p.y, a.p.y, b.p.y);
+    f(view.p.z, a.p.z, b.p.z);
+  }
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
+}
+
+/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
+template <class M, class V, class View, class F>
+COLLIDE_LANE_INLINE void write_bodies(const View& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b, F&& f) {
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
+}
+
+/// The streaming-pairs layout: contact l of the group joins bodies
+/// first + 2l and first + 2l + 1, so both sides come from 2W consecutive
+/// bodies (two vector loads and a deinterleave per field, instead of 2W
+/// scalar loads). This is how a caller lays out independent pairs, and how
+/// the pairs scene is built; any other layout takes the general gather.
+template <std::size_t W>
+COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* ib) {
+  bool paired = true;
+  for (std::size_t l = 0; l < W; ++l) {
+    paired &= (ia[l] == ia[0] + 2 * l) & (ib[l] == ia[l] + 1);
+  }
+  return paired;
+}
+
+/// True for the SoA views (BodyView, SphereView, ParticleView: one array per
+/// component), false for a PackedView of records.
+template <class View>
+inline constexpr bool kSoaLayout = true;
+template <class Record>
+inline constexpr bool kSoaLayout<PackedView<Record>> = false;
+
+/// Resolves one group of V::size() contacts.
+template <class M, class V, bool kFriction, class Mode, class T, class View>
+COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                                     const ContactGroup& g) {
+  constexpr std::size_t W = V::size();
+  BodyIndex ia[W];
+  BodyIndex ib[W];
+  for (std::size_t l = 0; l < W; ++l) {
+    const std::uint32_t k = g.contiguous ? g.first + static_cast<std::uint32_t>(l) : g.index[l];
+    ia[l] = contacts.a[k];
+    ib[l] = contacts.b[k];
+    assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
+  }
+  // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
+  // would gain nothing. The arithmetic is the same either way.
+  // The packed layout has no such shortcut (its records are already
+  // contiguous per body).
+  bool paired = false;
+  if constexpr (kSoaLayout<View>) paired = W > 1 && is_paired_layout<W>(ia, ib);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  if constexpr (kSoaLayout<View>) {
+    if (paired) {
+      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        load_deinterleaved(field + ia[0], la, lb);
+      });
+    }
+  }
+  if constexpr (kSoaLayout<View>) {
+    if (!paired) {
+      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        la = gather<V>(field, ia);
+        lb = gather<V>(field, ib);
+      });
+    }
+  } else {
+    read_records<M, V>(bodies, ia, a);
+    read_records<M, V>(bodies, ib, b);
+  }
+
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
+
+  const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
+
+  // An immovable body is never written, not even with its own value: another
+  // thread may be reading it (the ground is in many contacts of a batch).
+  const auto movable_a = a.inv_mass != V(0);
+  const auto movable_b = b.inv_mass != V(0);
+  bool written = false;
+  if constexpr (kSoaLayout<View>) {
+    if (paired && stdx::all_of(movable_a && movable_b)) {
+      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+        store_interleaved(la, lb, field + ia[0]);
+      });
+      written = true;
+    }
+  }
+  if constexpr (kSoaLayout<View>) {
+    if (!written) {
+      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+        scatter(la, field, ia, movable_a);
+        scatter(lb, field, ib, movable_b);
+      });
+    }
+  } else {
+    // a's records first, then b's: within a group no movable body repeats,
+    // so the order of the stores cannot matter.
+    write_records<M, V>(bodies, ia, a, movable_a);
+    write_records<M, V>(bodies, ib, b, movable_b);
+  }
+  if (g.contiguous) {
+    store(r.j.x, impulses.j.x + g.first);
+    store(r.j.y, impulses.j.y + g.first);
+    store(r.j.z, impulses.j.z + g.first);
+  } else {
+    const auto all = V(0) == V(0);
+    scatter(r.j.x, impulses.j.x, g.index, all);
+    scatter(r.j.y, impulses.j.y, g.index, all);
+    scatter(r.j.z, impulses.j.z, g.index, all);
+  }
+}
+
+/// Contacts [begin, end) of the schedule's order, all inside one batch, in
+/// groups of W; returns where the groups stopped (the tail, fewer than W
+/// contacts, is the caller's).
+///
+/// On the packed layout, the records of the contacts kPrefetchAhead
+/// positions ahead are requested before each group: a record is one to three
+/// lines, so the requests are few and the misses overlap instead of waiting
+/// one after another. In a scattered batch the contact's own lines (its body
+/// indices, fields and J) are requested twice as far ahead: the record
+/// requests read the body indices, which would otherwise be a demand miss
+/// of their own and stall the loop at every contact. That replaced copying
+/// the contacts into schedule order before the solve (and J back after):
+/// measured alternately in one process (debris, rigid, float, AVX-512, 2
+/// threads), the copy was no faster at 4M contacts, 20-30% slower at 1M, 5%
+/// faster in cache at 64k, and cost 56 bytes per contact of scratch.
+inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
+
+/// Asks for the lines of contact k's fields and of its J: a scattered batch
+/// reads them from lines that hold few other contacts of the batch. The
+/// contact point only when the model reads it (kPoint): a particle solve may
+/// have none (contacts.c null), and offsetting a null pointer is undefined
+/// even where only a prefetch uses the result.
+template <bool kPoint, class T>
+COLLIDE_LANE_INLINE void prefetch_contact(const ContactView<T>& c, const ImpulseView<T>& j, std::uint32_t k) {
+  __builtin_prefetch(c.a + k, 0, 2);
+  __builtin_prefetch(c.b + k, 0, 2);
+  if constexpr (kPoint) {
+    for (const T* f : {c.c.x, c.c.y, c.c.z}) __builtin_prefetch(f + k, 0, 2);
+  }
+  for (const T* f : {c.n.x, c.n.y, c.n.z}) __builtin_prefetch(f + k, 0, 2);
+  if (c.e != nullptr) __builtin_prefetch(c.e + k, 0, 2);
+  if (c.mu != nullptr) __builtin_prefetch(c.mu + k, 0, 2);
+  for (T* f : {j.j.x, j.j.y, j.j.z}) __builtin_prefetch(f + k, 1, 2);
+}
+
+template <class M, class V, bool kFriction, class Mode, class T, class View>
+COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactView<T>& contacts,
+                                             const ImpulseView<T>& impulses, const std::uint32_t* order,
+                                             bool contiguous, std::size_t begin, std::size_t end) {
+  constexpr std::size_t W = V::size();
+  std::size_t i = begin;
+  if constexpr (!kSoaLayout<View>) {
+    if (W > 1) {
+      if (!contiguous) {
+        for (std::size_t k = begin; k < std::min(end, begin + 2 * kPrefetchAhead); ++k) {
+          prefetch_contact<kRotates<M>>(contacts, impulses, order[k]);
+        }
+      }
+      for (std::size_t k = begin; k < std::min(end, begin + kPrefetchAhead); ++k) {
+        prefetch_record(bodies, contacts.a[order[k]]);
+        prefetch_record(bodies, contacts.b[order[k]]);
+      }
+      for (; i + W <= end; i += W) {
+        if (!contiguous) {
+          for (std::size_t k = i + 2 * kPrefetchAhead; k < std::min(end, i + W + 2 * kPrefetchAhead); ++k) {
+            prefetch_contact<kRotates<M>>(contacts, impulses, order[k]);
+          }
+        }
+        for (std::size_t k = i + kPrefetchAhead; k < std::min(end, i + W + kPrefetchAhead); ++k) {
+          prefetch_record(bodies, contacts.a[order[k]]);
+          prefetch_record(bodies, contacts.b[order[k]]);
+        }
+        solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses,
+                                              ContactGroup{contiguous, order[i], order + i});
+      }
+      return i;
+    }
+  }
+  for (; i + W <= end; i += W) {
+    solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+  }
+  return i;
+}
+
+/// The job's model and friction, as template arguments.
+template <class V, class T, class Mode>
+std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  // `view` is a SoA view or a PackedView: solve_group tells them apart.
+  const auto run = [&](const auto& view, auto model, auto friction) {
+    using M = decltype(model);
+    constexpr bool kFriction = decltype(friction)::value;
+    return solve_groups<M, V, kFriction, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin, end);
+  };
+  const std::true_type with_friction;
+  const std::false_type without;
+  if (job.packed) {
+    switch (job.model) {
+      case Model::particle:
+        return job.friction ? run(job.packed_particle, ParticleModel{}, with_friction)
+                            : run(job.packed_particle, ParticleModel{}, without);
+      case Model::sphere:
+        return job.friction ? run(job.packed_sphere, SphereModel{}, with_friction)
+                            : run(job.packed_sphere, SphereModel{}, without);
+      case Model::rigid:
+        break;
+    }
+    return job.friction ? run(job.packed_rigid, RigidModel{}, with_friction)
+                        : run(job.packed_rigid, RigidModel{}, without);
+  }
+  switch (job.model) {
+    case Model::particle:
+      return job.friction ? run(job.particle, ParticleModel{}, with_friction)
+                          : run(job.particle, ParticleModel{}, without);
+    case Model::sphere:
+      return job.friction ? run(job.sphere, SphereModel{}, with_friction) : run(job.sphere, SphereModel{}, without);
+    case Model::rigid:
+      break;
+  }
+  return job.friction ? run(job.rigid, RigidModel{}, with_friction) : run(job.rigid, RigidModel{}, without);
+}
+
+/// ... and its accuracy mode.
+template <class V, class T>
+std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  return job.accurate ? solve_job_groups_in<V, T, AccurateMode>(job, contiguous, begin, end)
+                      : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
+}
+
+}  // namespace
+}  // namespace COLLIDE_KERNEL_NS
+
+#define COLLIDE_CONCAT_(a, b) a##b
+#define COLLIDE_CONCAT(a, b) COLLIDE_CONCAT_(a, b)
+
+namespace {
+
+/// The SIMD entry of this ISA: full groups in its lanes, the tail in the
+/// baseline's one lane.
+template <class T>
+void solve_range_simd(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  const std::size_t tail = solve_job_groups<SimdLanes<T>, T>(job, contiguous, begin, end);
+  if (tail < end) solve_range_scalar<T>(job, contiguous, tail, end);
+}
+
+Isa this_isa() {
+#if defined(COLLIDE_KERNEL_ISA_avx512)
+  return Isa::avx512;
+#elif defined(COLLIDE_KERNEL_ISA_avx2)
+  return Isa::avx2;
+#else
+  return Isa::sse2;
+#endif
+}
+
+}  // namespace
+
+const KernelTable& COLLIDE_CONCAT(kernel_table_, COLLIDE_KERNEL_NS)() {
+  static const KernelTable table{this_isa(), SimdLanes<float>::size(), SimdLanes<double>::size(),
+                                 &solve_range_simd<float>, &solve_range_simd<double>};
+  return table;
+}
+
+#if defined(COLLIDE_KERNEL_ISA_sse2) || defined(COLLIDE_KERNEL_ISA_native)
+// The baseline object also holds the one-lane kernel.
+template <class T>
+void solve_range_scalar(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  [[maybe_unused]] const std::size_t stop = solve_job_groups<ScalarLanes<T>, T>(job, contiguous, begin, end);
+  assert(stop == end);
+}
+template void solve_range_scalar<float>(const KernelJob<float>&, bool, std::size_t, std::size_t);
+template void solve_range_scalar<double>(const KernelJob<double>&, bool, std::size_t, std::size_t);
+#endif
+
+}  // namespace collide::detail

@@ -1,0 +1,421 @@
+// schedule.cpp - the level schedule of schedule.hpp, built in four passes.
+//
+// 1. Body table (streaming over bodies): body_next_[i] is the first
+//    free batch of body i, 0 to start with, or a sentinel for a body with
+//    inverse mass 0. Folding "movable" into the table means the level pass
+//    reads one random word per body instead of two (the inverse mass and the
+//    batch), and the inverse masses are read once, in order.
+// 2. Level pass (sequential, in input order): contact k gets batch
+//    max(body_next_[a], body_next_[b]) over its movable bodies, and those
+//    bodies' entries become that batch + 1. The level of contact k depends on
+//    every earlier contact, so this pass cannot be split exactly (a chunk's
+//    levels are a max-plus function of every body's incoming batch, and
+//    evaluating it costs a second pass). On scattered bodies (the debris
+//    scene: random indices over contacts/2 bodies) it is bound by the latency
+//    of the two random body_next_ entries, which the indices kPrefetchDistance
+//    contacts ahead make predictable: prefetching them keeps enough misses in
+//    flight. It counts nothing per level: a histogram increment there is a
+//    store-to-load chain whenever neighbours share a level (every contact on
+//    the pairs scene), and cost a fifth of the pass (measured).
+//    Every index is checked (< the body count, a != b) before it is used:
+//    each block of kCheckBlock contacts is screened branch-free, then
+//    assigned, and a contact that fails throws before any body word of it
+//    is read or written. A branch per contact inside the loop cost 7% of the
+//    build on debris and 12 to 16% on pairs at 2M contacts; the blocks (with
+//    the next block's indices prefetched and the screen's AVX2 clone) cost
+//    5 to 6% and 6 to 8%, and 3% and 4 to 5% at 200k (float, one thread, min
+//    of 20 alternated with the unchecked build, whose own repeats agree
+//    within 2%; AMD EPYC, GCC 12, on a loaded machine).
+//    Both arrays hold one byte per body and per contact while the levels fit
+//    (fewer than 254 batches: every scene but long chains): the body table of
+//    1M bodies then fits in L2, and every pass streams a quarter of the
+//    bytes. The first contact whose level does not fit widens both arrays to
+//    32-bit words in place, and the pass goes on from that contact.
+// 3. Stable counting sort by level (parallel over chunks of contacts): each
+//    chunk counts its levels, a prefix over (level, chunk) gives every chunk
+//    its first slot in every batch, and each chunk scatters its contacts in
+//    input order. The result is the sequential stable sort, whatever the
+//    number of chunks; a scene of one level (the pairs scene) is the identity.
+//    Passes 1 and 3 of a one-level scene stream a few bytes per contact and
+//    take a fraction of a millisecond per million: they stay on the calling
+//    thread, since waking workers for them cost more wall time than it saved
+//    on a loaded machine (measured: the pairs rows).
+// 4. Contiguity and the largest batch: O(batches).
+//
+// The level pass is bound by the random reads of the body table: a prefetch
+// 16 contacts ahead hides them (8 leaves misses exposed, 16 to 64 are alike),
+// and the table is kept in bytes. The measurements behind these choices are
+// in docs/decisions/; the bench rows schedule/<scene>/... time the whole
+// build.
+#include "collide/schedule.hpp"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+#include <oneapi/tbb/task_arena.h>
+
+namespace collide {
+namespace {
+
+/// The wide body-table sentinel; contact counts stay below it.
+constexpr std::uint32_t kImmovable = std::numeric_limits<std::uint32_t>::max();
+
+/// Contacts ahead whose bodies the level pass prefetches. Measured on the
+/// debris scene at 2M and 4M contacts: 8 leaves misses exposed, 16 to 64 are
+/// within 5% of each other.
+constexpr std::size_t kPrefetchDistance = 16;
+
+/// Fewest contacts (or bodies) per parallel chunk: below that, starting a
+/// task costs more than the chunk.
+constexpr std::size_t kMinChunk = std::size_t{1} << 15;
+
+/// Per-chunk level counts may take at most one 4-byte count per this many
+/// contacts (1 B per contact), which keeps a scene of many small batches (a
+/// chain) sequential and inside the memory budget of schedule.hpp.
+constexpr std::size_t kContactsPerCount = 4;
+
+inline void prefetch_for_write(const void* p) {
+#if defined(__GNUC__)
+  __builtin_prefetch(p, 1, 3);
+#else
+  (void)p;
+#endif
+}
+
+/// Chunks for `items` items on `threads` threads: at least one, at most one
+/// per kMinChunk items.
+std::size_t chunk_count(std::size_t items, std::size_t threads) {
+  return std::max<std::size_t>(1, std::min(threads, items / kMinChunk));
+}
+
+/// Runs f(chunk, begin, end) over `chunks` equal slices of [0, items), in
+/// parallel in the calling thread's arena when there is more than one.
+template <class F>
+void for_each_chunk(std::size_t items, std::size_t chunks, const F& f) {
+  const auto begin = [&](std::size_t c) { return items / chunks * c + std::min(c, items % chunks); };
+  if (chunks == 1) {
+    f(std::size_t{0}, std::size_t{0}, items);
+    return;
+  }
+  tbb::parallel_for(
+      std::size_t{0}, chunks, [&](std::size_t c) { f(c, begin(c), begin(c + 1)); }, tbb::simple_partitioner());
+}
+
+/// The body-table word of a body that never conflicts (inverse mass 0). No
+/// level + 1 equals it: a narrow pass stops before (see assign_levels), and a
+/// wide level is at most contacts - 1 < 2^32 - 2.
+template <class Word>
+constexpr Word kImmovableWord = std::numeric_limits<Word>::max();
+
+/// Pass 1 for the bodies [begin, end); body i's inverse mass is
+/// inv_mass[i * stride] (1 for SoA views, the record size for packed ones).
+template <class Word, class T>
+void fill_body_table(const T* inv_mass, std::size_t stride, std::size_t begin, std::size_t end, Word* next) {
+  for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i * stride] != T(0) ? Word{0} : kImmovableWord<Word>;
+}
+
+/// Throws the std::invalid_argument for the first contact of [k, end) with
+/// an index >= body_count or a == b, naming it as validate() does; returns
+/// when there is none. Out of line and cold: only a failed check_indices()
+/// calls it.
+__attribute__((noinline, cold)) void throw_bad_contact(const BodyIndex* a, const BodyIndex* b, std::size_t k,
+                                                       std::size_t end, std::size_t body_count) {
+  for (; k < end; ++k) {
+    if (a[k] < body_count && b[k] < body_count && a[k] != b[k]) continue;
+    const std::string at = "[" + std::to_string(k) + "] = ";
+    const std::string range = ": out of range (" + std::to_string(body_count) + " bodies)";
+    std::string what = "collide::Schedule::build: contacts.";
+    if (a[k] >= body_count) {
+      what += "a" + at + std::to_string(a[k]) + range;
+    } else if (b[k] >= body_count) {
+      what += "b" + at + std::to_string(b[k]) + range;
+    } else {
+      what += "b" + at + std::to_string(b[k]) + ": a contact of a body with itself";
+    }
+    throw std::invalid_argument(what);
+  }
+}
+
+/// Contacts the level pass checks at a time (check_indices) before it uses
+/// their indices: 2 KiB of indices, still in L1 when the pass reads them
+/// (1024 measured slower: 12% over the unchecked build on pairs).
+constexpr std::size_t kCheckBlock = 256;
+
+/// Whether every contact of [0, count) has both indices < bound and a != b.
+/// Branch-free, so that it vectorises; with GCC on x86-64 it is also
+/// compiled for AVX2 and picked at load time (an ifunc), as validate.cpp's
+/// index screen is: SSE2 has no unsigned 32-bit compare or max.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+bool indices_below(const BodyIndex* a, const BodyIndex* b, std::size_t count, BodyIndex bound) {
+  std::uint32_t bad = 0;
+  for (std::size_t c = 0; c < count; ++c) {
+    bad |= static_cast<std::uint32_t>(a[c] >= bound) | static_cast<std::uint32_t>(b[c] >= bound) |
+           static_cast<std::uint32_t>(a[c] == b[c]);
+  }
+  return bad == 0;
+}
+
+/// Throws (throw_bad_contact) unless every contact of [k, end) has both
+/// indices < body_count and a != b. With 2^32 or more bodies the 32-bit
+/// bound is one too strict for index 2^32 - 1, which the exact scan in
+/// throw_bad_contact then accepts.
+inline void check_indices(const BodyIndex* a, const BodyIndex* b, std::size_t k, std::size_t end,
+                          std::size_t body_count) {
+  const auto bound = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
+  if (__builtin_expect(!indices_below(a + k, b + k, end - k, bound), 0)) throw_bad_contact(a, b, k, end, body_count);
+}
+
+/// Pass 2 from contact k on: the level of each contact from the body table.
+/// Raises `levels` to the number of levels, adds the dependencies met to
+/// `conflicts`, and returns the contact where it stopped: n, or for a narrow
+/// Word the first contact whose level + 1 would not fit below the sentinel,
+/// left untouched. Every block of kCheckBlock contacts is checked
+/// (check_indices) before any of its indices is used, so a contact with an
+/// index >= body_count or a == b throws before a body word is read or
+/// written; the prefetches ahead may name such an index, which is harmless
+/// (a prefetch never faults).
+template <class Word>
+std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __restrict b, std::size_t k, std::size_t n,
+                          std::size_t body_count, Word* __restrict next, Word* __restrict level, std::uint32_t& levels,
+                          std::size_t& conflicts) {
+  constexpr Word immovable = kImmovableWord<Word>;
+  std::uint32_t count = levels;
+  std::size_t met = 0;
+  const auto one = [&](std::size_t c) {
+    const BodyIndex i = a[c];
+    const BodyIndex j = b[c];
+    const Word next_i = next[i];
+    const Word next_j = next[j];
+    const bool movable_i = next_i != immovable;
+    const bool movable_j = next_j != immovable;
+    const Word after_i = movable_i ? next_i : Word{0};
+    const Word after_j = movable_j ? next_j : Word{0};
+    const Word L = std::max(after_i, after_j);
+    if constexpr (sizeof(Word) < sizeof(std::uint32_t)) {
+      if (L == immovable - 1) return false;
+    }
+    met += static_cast<std::size_t>(after_i > 0) + static_cast<std::size_t>(after_j > 0);
+    level[c] = L;
+    // Branches, not selects: a select stores the sentinel back into the
+    // ground's word and chains every ground contact through it (measured
+    // slower).
+    if (movable_i) next[i] = static_cast<Word>(L + 1);
+    if (movable_j) next[j] = static_cast<Word>(L + 1);
+    count = std::max<std::uint32_t>(count, std::uint32_t{L} + 1);
+    return true;
+  };
+  const auto stop = [&](std::size_t at) {
+    levels = count;
+    conflicts += met;
+    return at;
+  };
+  const std::size_t ahead = n > kPrefetchDistance ? n - kPrefetchDistance : 0;
+  while (k < n) {
+    const std::size_t end = std::min(n, k + kCheckBlock);
+    check_indices(a, b, k, end, body_count);
+    // The next block's indices: its check reads them in a burst, which on
+    // scattered scenes otherwise waits on memory once per block.
+    for (std::size_t p = end; p < std::min(n, end + kCheckBlock); p += 64 / sizeof(BodyIndex)) {
+      __builtin_prefetch(a + p, 0, 3);
+      __builtin_prefetch(b + p, 0, 3);
+    }
+    for (const std::size_t prefetched = std::min(end, ahead); k < prefetched; ++k) {
+      prefetch_for_write(next + a[k + kPrefetchDistance]);
+      prefetch_for_write(next + b[k + kPrefetchDistance]);
+      if (!one(k)) return stop(k);
+    }
+    for (; k < end; ++k) {
+      if (!one(k)) return stop(k);
+    }
+  }
+  return stop(n);
+}
+
+/// Adds the number of contacts of each level in [begin, end) to count[L].
+/// Byte levels are counted in four interleaved tables: one table would make
+/// neighbours of the same level (every contact of a pairs scene) wait on each
+/// other's store.
+template <class Level>
+void count_levels(const Level* level, std::size_t begin, std::size_t end, std::uint32_t* count) {
+  if constexpr (sizeof(Level) == 1) {
+    std::array<std::array<std::uint32_t, 256>, 4> part{};
+    std::size_t k = begin;
+    for (; k + 4 <= end; k += 4) {
+      ++part[0][level[k]];
+      ++part[1][level[k + 1]];
+      ++part[2][level[k + 2]];
+      ++part[3][level[k + 3]];
+    }
+    for (; k < end; ++k) ++part[0][level[k]];
+    for (std::size_t L = 0; L < 256; ++L) {
+      const std::uint32_t sum = part[0][L] + part[1][L] + part[2][L] + part[3][L];
+      if (sum != 0) count[L] += sum;
+    }
+  } else {
+    for (std::size_t k = begin; k < end; ++k) ++count[level[k]];
+  }
+}
+
+/// Turns the first `count` bytes of `words` into `count` words, the byte
+/// sentinel into the word sentinel.
+void widen(std::vector<std::uint32_t>& words, std::size_t count) {
+  words.resize(count);  // keeps the bytes of the narrow words
+  std::uint32_t* const wide = words.data();
+  const auto* const narrow = reinterpret_cast<const std::uint8_t*>(wide);
+  // Backwards: word i covers bytes 4i..4i+3, which are read already.
+  for (std::size_t i = count; i-- > 0;) {
+    const std::uint8_t v = narrow[i];
+    wide[i] = v == kImmovableWord<std::uint8_t> ? kImmovable : v;
+  }
+}
+
+}  // namespace
+
+template <class T>
+void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass,
+                             std::size_t stride, int threads) {
+  // Empty until the build succeeds: a build that throws leaves a schedule of
+  // nothing (the buffers keep their capacity), which no solve of a non-empty
+  // scene accepts (Solver::solve compares the counts). order_ keeps its size:
+  // every entry is rewritten by a build that succeeds, and clearing it made
+  // the resize below write the whole array once more (a fifth of the pairs
+  // scene's build).
+  const auto reset = [this] {
+    contact_count_ = 0;
+    body_count_ = 0;
+    largest_batch_ = 0;
+    conflicts_ = 0;
+    batch_begin_.clear();
+    contiguous_.clear();
+  };
+  reset();
+  if (threads < 0) {
+    throw std::invalid_argument("collide::Schedule::build: threads must be >= 0, got " + std::to_string(threads));
+  }
+  const std::size_t n = contacts.count;
+  if (n >= kImmovable) {
+    throw std::length_error("collide::Schedule::build: " + std::to_string(n) +
+                            " contacts; a schedule holds at most 2^32 - 2");
+  }
+  if (n > 0 && (contacts.a == nullptr || contacts.b == nullptr)) {
+    throw std::invalid_argument("collide::Schedule::build: contacts.a or contacts.b is null but contacts.count = " +
+                                std::to_string(n));
+  }
+  if (body_count > 0 && inv_mass == nullptr) {
+    throw std::invalid_argument("collide::Schedule::build: bodies.inv_mass is null but bodies.count = " +
+                                std::to_string(body_count));
+  }
+  const std::size_t workers = threads > 0
+                                  ? static_cast<std::size_t>(threads)
+                                  : static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  try {
+    order_.resize(n);
+
+    // Passes 1 and 2 on one byte per body and per contact while the levels
+    // fit in it (every scene of fewer than 254 batches): a quarter of the
+    // random lines and of the bytes streamed. The first contact that would
+    // need a wider level switches both arrays to words, and the pass goes on
+    // from it. The level pass checks every index before it uses it.
+    body_next_.resize((body_count + 3) / 4);
+    level_.resize((n + 3) / 4);
+    auto* const next8 = reinterpret_cast<std::uint8_t*>(body_next_.data());
+    fill_body_table(inv_mass, stride, 0, body_count, next8);
+    std::uint32_t levels = 0;
+    std::size_t conflicts = 0;
+    const std::size_t stop = assign_levels(contacts.a, contacts.b, 0, n, body_count, next8,
+                                           reinterpret_cast<std::uint8_t*>(level_.data()), levels, conflicts);
+    contact_count_ = n;
+    if (stop == n) {
+      sort_by_level(reinterpret_cast<const std::uint8_t*>(level_.data()), levels, workers);
+    } else {
+      widen(body_next_, body_count);
+      widen(level_, n);
+      assign_levels(contacts.a, contacts.b, stop, n, body_count, body_next_.data(), level_.data(), levels, conflicts);
+      sort_by_level(static_cast<const std::uint32_t*>(level_.data()), levels, workers);
+    }
+    body_count_ = body_count;
+    conflicts_ = conflicts;
+  } catch (...) {
+    reset();
+    throw;
+  }
+}
+
+template <class Level>
+void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers) {
+  const std::size_t n = contact_count_;
+  std::uint32_t* const order = order_.data();
+  batch_begin_.assign(static_cast<std::size_t>(levels) + 1, 0);
+  std::size_t chunks = chunk_count(n, workers);
+  if (chunks > 1 && chunks * levels > n / kContactsPerCount) chunks = 1;
+  if (levels == 1) {
+    // One batch: every contact in input order.
+    std::iota(order, order + n, std::uint32_t{0});
+    batch_begin_[1] = static_cast<std::uint32_t>(n);
+  } else if (chunks == 1) {
+    // batch_begin_[L + 1] counts level L, the prefix sum turns counts into
+    // starts, and filling advances batch_begin_[L] to the end of level L;
+    // shifting by one restores starts.
+    count_levels(level, 0, n, batch_begin_.data() + 1);
+    for (std::size_t L = 1; L <= levels; ++L) batch_begin_[L] += batch_begin_[L - 1];
+    for (std::size_t k = 0; k < n; ++k) order[batch_begin_[level[k]]++] = static_cast<std::uint32_t>(k);
+    for (std::size_t L = levels; L > 0; --L) batch_begin_[L] = batch_begin_[L - 1];
+    batch_begin_[0] = 0;
+  } else {
+    // slot_[c * levels + L]: the count of level L in chunk c, then the slot of
+    // chunk c's first contact of level L. Chunk c's contacts of a level follow
+    // those of chunks < c, so the order is the sequential stable sort's.
+    slot_.assign(chunks * levels, 0);
+    std::uint32_t* const slot = slot_.data();
+    for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
+      std::uint32_t* const count = slot + c * levels;
+      count_levels(level, begin, end, count);
+    });
+    std::uint32_t start = 0;
+    for (std::size_t L = 0; L < levels; ++L) {
+      batch_begin_[L] = start;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const std::uint32_t count = slot[c * levels + L];
+        slot[c * levels + L] = start;
+        start += count;
+      }
+    }
+    batch_begin_[levels] = start;
+    for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
+      std::uint32_t* const next_slot = slot + c * levels;
+      for (std::size_t k = begin; k < end; ++k) order[next_slot[level[k]]++] = static_cast<std::uint32_t>(k);
+    });
+  }
+
+  // Pass 4: contiguity and the largest batch.
+  contiguous_.assign(levels, 0);
+  largest_batch_ = 0;
+  for (std::size_t L = 0; L < levels; ++L) {
+    const std::size_t begin = batch_begin_[L];
+    const std::size_t end = batch_begin_[L + 1];
+    largest_batch_ = std::max(largest_batch_, end - begin);
+    // Ascending and distinct, so consecutive exactly when the span fits.
+    contiguous_[L] = static_cast<std::uint8_t>(order[end - 1] - order[begin] == end - begin - 1);
+  }
+}
+
+std::size_t Schedule::memory_bytes() const {
+  return order_.capacity() * sizeof(std::uint32_t) + level_.capacity() * sizeof(std::uint32_t) +
+         body_next_.capacity() * sizeof(std::uint32_t) + batch_begin_.capacity() * sizeof(std::uint32_t) +
+         contiguous_.capacity() * sizeof(std::uint8_t) + slot_.capacity() * sizeof(std::uint32_t);
+}
+
+template void Schedule::build_strided<float>(const ContactView<float>&, std::size_t, const float*, std::size_t, int);
+template void Schedule::build_strided<double>(const ContactView<double>&, std::size_t, const double*, std::size_t, int);
+template void Schedule::build_strided<long double>(const ContactView<long double>&, std::size_t, const long double*,
+                                                   std::size_t, int);
+
+}  // namespace collide

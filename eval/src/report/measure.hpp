@@ -1,0 +1,78 @@
+// report/measure.hpp - what the rows of the report share (measure.cpp), the
+// hard section (hard_rows.cpp) and the Bullet peer row (bullet_row.cpp);
+// private to the report engine.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+#include "collide/eval/reference.hpp"
+#include "report.hpp"
+#include "collide/io/scene.hpp"
+
+namespace collide::report_detail {
+
+// ---------------------------------------------------------------------------
+// Error against the reference (measure.cpp).
+// ---------------------------------------------------------------------------
+
+/// Linear momentum, angular momentum about the origin (orbital p x m v plus
+/// spin), kinetic energy, and the scales the drifts are divided by. Locked
+/// axes (inverse moment 0) are left out of the spin terms: their spin never
+/// changes, and their moment is infinite.
+struct Totals {
+  long double p[3] = {0, 0, 0};
+  long double l[3] = {0, 0, 0};
+  long double energy = 0;
+  long double p_scale = 0;  ///< sum m |v|
+  long double l_scale = 0;  ///< sum |p x m v| + |I w|
+};
+template <class T>
+Totals body_totals(const BodyView<const T>& bodies);
+
+/// The long double reference for one error sample.
+struct ReferenceResult {
+  ImpulseBuffer<long double> impulses;
+  std::vector<ReferenceContact<long double>> diagnostics;
+  Totals before, after;
+};
+/// Solves convert_scene<long double>(sample) with reference_solve<long double>.
+template <class T>
+ReferenceResult reference_of(const Scene<T>& sample);
+
+/// Fills the error columns of `row` from a variant's impulses and final
+/// bodies on the sample, in units of eps (the row's precision).
+template <class T>
+void fill_error(ReportRow& row, const ImpulseView<const T>& impulses, const BodyView<const T>& after,
+                const ReferenceResult& reference, double eps);
+
+/// Median of a list of run times.
+double median(std::vector<double> values);
+
+// ---------------------------------------------------------------------------
+// The hard section (hard_rows.cpp).
+// ---------------------------------------------------------------------------
+
+/// Every scene of hard::hard_scene_catalogue() in float and double (float
+/// only where the scene is meant for float), fast then accurate, in
+/// catalogue order; `progress` is told what runs.
+std::vector<HardRow> measure_hard_rows(const ReportOptions& options,
+                                       const std::function<void(const std::string&)>& progress);
+
+// ---------------------------------------------------------------------------
+// The peer (bullet_row.cpp, only with COLLIDE_WITH_BULLET).
+// ---------------------------------------------------------------------------
+
+/// "bullet <version>" when the peer is compiled in, "" otherwise.
+std::string bullet_version();
+/// Measures btSequentialImpulseConstraintSolver on the first `n` contacts of
+/// the pairs scene `scene` (frictionless, float), `runs` timed runs, and on
+/// the error sample.
+ReportRow bullet_row(const Scene<float>& scene, std::size_t n, const Scene<float>& sample,
+                     const ReferenceResult& reference, int runs, double triad_bytes_per_second);
+
+}  // namespace collide::report_detail

@@ -1,0 +1,717 @@
+// report/run_report.cpp - the engine of `collide report` (and of
+// collide.report() in Python): speed against error for every variant, on the
+// pairs and the debris scene. The shells print and write what it returns.
+//
+// Design notes
+// ------------
+// * Speed: each variant solves the full scene (--n collisions) `runs` times;
+//   before each run the velocities are restored from a saved copy, untimed,
+//   and only the solve call is timed (Solver::solve for the kernel). The
+//   median run is the row's speed, so one run disturbed by another process on
+//   this shared machine does not move it. The schedule is built once per
+//   scene, as a user solving every frame would do.
+// * The bandwidth bound: collisions/s x bytes_per_collision(model, sizeof(T),
+//   friction) (traffic.hpp) / triad bandwidth (bandwidth.hpp) measured at the
+//   same thread count at the start of the same run.
+// * Error: each variant also solves an error sample (its own scene of
+//   --sample contacts; for the pairs scene that is exactly the first pairs of
+//   the full scene, since pair k depends only on (seed, k)), and its impulses
+//   and final bodies are compared with reference_solve<long double> on
+//   exactly the same stored inputs (convert_scene, no renormalising). The
+//   error columns are defined in docs/report.md.
+// * Models: the generated scenes need the rigid model. The sphere and the
+//   particle rows run on scenes derived from them in place (sphere: every
+//   inverse moment set to the x one; particle: inverse moments 0 and w = 0),
+//   checked with model_misfit(), so every row is the law's result for its
+//   scene. Deriving in place, rigid then sphere then particle, needs no copy
+//   of a scene of millions of bodies.
+// * Budget (the default run is README command 1 and must take a few
+//   minutes on a 2-core machine): the pairs scene has --n collisions (4M by
+//   default); the debris scene min(--n, 1M) unless --debris-n says otherwise,
+//   because its random body accesses make it 3 to 10 times slower per
+//   collision (latency-bound gathers), and 48 kernel rows of five runs of 4M
+//   debris collisions took 400 s here. The slow rows (the reference in long
+//   double and in double, the textbook loop, the Bullet peer; single-threaded
+//   by nature) are timed on the first 500k contacts only; the row's n and
+//   note say so. Their per-collision speed does not depend on n once the
+//   scene is out of the last-level cache, which 500k contacts are in every
+//   precision (46 MB of bodies and more).
+// * The N sweep (panel 2 of the plot) runs on prefixes of one pairs scene of
+//   the largest N: the first N pairs of the pairs scene are the N-pair scene.
+// * The hard section (--hard, hard_rows.cpp) runs after the two scenes:
+//   every hard scene of collide/eval/hard_scenes.hpp in both accuracy modes.
+// * A kernel variant whose error exceeds kImpulseErrorBoundEps makes the
+//   command exit 3, like `solve --check` (and a hard row of the accurate
+//   mode above kAccurateErrorUlps); the table and files are written first.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "collide/eval/bandwidth.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/io/generate.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/eval/reference.hpp"
+#include "report.hpp"
+#include "collide/rules.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
+#include "collide/io/scene_npz.hpp"
+#include "collide/schedule.hpp"
+#include "collide/solve.hpp"
+#include "collide/eval/traffic.hpp"
+#include "measure.hpp"
+#include "textbook.hpp"
+
+namespace collide {
+
+namespace {
+
+using namespace report_detail;
+
+using Clock = std::chrono::steady_clock;
+using L = long double;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// ---------------------------------------------------------------------------
+// Progress on a terminal.
+// ---------------------------------------------------------------------------
+
+/// "collide report: [12/98] pairs float friction: simd rigid, 2 threads" on
+/// stderr, rewritten in place; nothing when stderr is not a terminal, so logs
+/// and tests see no carriage returns.
+class Progress {
+ public:
+  explicit Progress(std::size_t total) : total_(total), enabled_(::isatty(STDERR_FILENO) != 0) {}
+  ~Progress() { clear(); }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  void step(const std::string& what) {
+    ++done_;
+    show(what);
+  }
+  void show(const std::string& what) const {
+    if (!enabled_) return;
+    std::fprintf(stderr, "\r\033[Kcollide report: [%zu/%zu] %s", std::min(done_, total_), total_, what.c_str());
+    std::fflush(stderr);
+  }
+  void clear() const {
+    if (enabled_) std::fputs("\r\033[K", stderr);
+  }
+
+ private:
+  std::size_t total_;
+  std::size_t done_ = 0;
+  bool enabled_;
+};
+
+// ---------------------------------------------------------------------------
+// Scenes.
+// ---------------------------------------------------------------------------
+
+enum class SceneKind { pairs, debris, file };
+const char* scene_name(SceneKind kind) {
+  return kind == SceneKind::pairs ? "pairs" : kind == SceneKind::debris ? "debris" : "file";
+}
+
+/// The caller's scene (ReportOptions::scene_bodies, scene_contacts) in T,
+/// every rule checked as `collide solve` checks it.
+template <class T>
+Scene<T> read_scene_files(const std::string& bodies_path, const std::string& contacts_path) {
+  const LoadedBodies<T> bodies = load_bodies<T>(bodies_path, scene_format_of(bodies_path));
+  const LoadedContacts<T> contacts = load_contacts<T>(contacts_path, scene_format_of(contacts_path), bodies.size());
+  Scene<T> scene;
+  scene.bodies = to_body_buffer(bodies.columns());
+  scene.contacts.assign_exact(contacts.view());
+  return scene;
+}
+
+/// The first `k` contacts of a scene with only the bodies they touch,
+/// renumbered in order of first use. The law applies contacts in input
+/// order, so each of them gets the impulse it gets in the whole scene; the
+/// reference of a sample then needs the sample's bodies, not all of them.
+template <class T>
+Scene<T> contact_prefix(const Scene<T>& scene, std::size_t k) {
+  const ContactView<T> c = scene.contacts.view();
+  const BodyView<const T> b = scene.bodies.view();
+  k = std::min(k, c.count);
+  std::vector<BodyIndex> id(b.count, std::numeric_limits<BodyIndex>::max());
+  std::vector<BodyIndex> used;
+  const auto renumber = [&](BodyIndex i) {
+    if (id[i] == std::numeric_limits<BodyIndex>::max()) {
+      id[i] = static_cast<BodyIndex>(used.size());
+      used.push_back(i);
+    }
+    return id[i];
+  };
+  Scene<T> out;
+  out.contacts.resize(k);
+  for (std::size_t j = 0; j < k; ++j) {
+    ContactRecord<T> r = scene.contacts.record(j);
+    r.a = renumber(r.a);
+    r.b = renumber(r.b);
+    out.contacts.set(j, r);
+  }
+  out.bodies.resize(used.size());
+  for (std::size_t i = 0; i < used.size(); ++i) out.bodies.set(i, scene.bodies.record(used[i]));
+  return out;
+}
+
+template <class T>
+Scene<T> make_scene(SceneKind kind, std::size_t n, bool friction, std::uint64_t seed) {
+  GenerateOptions options;
+  options.seed = seed;
+  options.friction = friction;
+  return kind == SceneKind::pairs ? generate_pairs<T>(n, options) : generate_debris<T>(n, options);
+}
+
+/// Turns a rigid scene into one that `model` fits (see the design notes).
+template <class T>
+void derive_model(Scene<T>& scene, Model model) {
+  BodyView<T> b = scene.bodies.view();
+  for (std::size_t i = 0; i < b.count; ++i) {
+    if (model == Model::sphere) {
+      b.inv_inertia.y[i] = b.inv_inertia.x[i];
+      b.inv_inertia.z[i] = b.inv_inertia.x[i];
+    } else if (model == Model::particle) {
+      b.inv_inertia.x[i] = b.inv_inertia.y[i] = b.inv_inertia.z[i] = T(0);
+      b.w.x[i] = b.w.y[i] = b.w.z[i] = T(0);
+    }
+  }
+  if (const std::string misfit = model_misfit(model, b, scene.contacts.view()); !misfit.empty()) {
+    throw std::logic_error(std::string("derived ") + to_string(model) + " scene does not fit: " + misfit);
+  }
+}
+
+/// The velocities of the first `count` bodies, saved so that every timed run
+/// starts from the same state.
+template <class T>
+class SavedVelocities {
+ public:
+  void save(const BodyView<T>& b, std::size_t count) {
+    T* const src[6] = {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
+    for (int c = 0; c < 6; ++c) saved_[c].assign(src[c], src[c] + count);
+  }
+  void restore(const BodyView<T>& b) const {
+    T* const dst[6] = {b.v.x, b.v.y, b.v.z, b.w.x, b.w.y, b.w.z};
+    for (int c = 0; c < 6; ++c) std::copy(saved_[c].begin(), saved_[c].end(), dst[c]);
+  }
+
+ private:
+  std::vector<T> saved_[6];
+};
+
+/// `runs` timed calls of solve(), each after an untimed restore().
+template <class Restore, class Solve>
+std::vector<double> time_runs(int runs, const Restore& restore, const Solve& solve) {
+  std::vector<double> seconds;
+  for (int r = 0; r < runs; ++r) {
+    restore();
+    const auto t0 = Clock::now();
+    solve();
+    seconds.push_back(seconds_since(t0));
+  }
+  return seconds;
+}
+
+// ---------------------------------------------------------------------------
+// The run.
+// ---------------------------------------------------------------------------
+
+using Config = ReportOptions;
+
+constexpr Model kModels[] = {Model::rigid, Model::sphere, Model::particle};
+constexpr std::pair<Path, Accuracy> kKernelVariants[] = {
+    {Path::scalar, Accuracy::fast}, {Path::simd, Accuracy::fast}, {Path::simd, Accuracy::accurate}};
+
+class Runner {
+ public:
+  Runner(const Config& config, Report& report) : config_(config), report_(report) {}
+
+  void run() {
+    progress_ = std::make_unique<Progress>(expected_rows() + config_.sweep_n.size() * 2);
+    auto phase = Clock::now();
+    auto end_phase = [&](const char* name) {
+      report_.phase_seconds.emplace_back(name, seconds_since(phase));
+      phase = Clock::now();
+    };
+    measure_machine();
+    end_phase("triad");
+    for (const SceneKind kind : {SceneKind::pairs, SceneKind::debris}) {
+      for (const bool friction : {false, true}) {
+        run_scene<double>(kind, friction);
+        run_scene<float>(kind, friction);
+      }
+      end_phase(scene_name(kind));
+    }
+    if (!config_.scene_bodies.empty()) {
+      run_file_scene<double>();
+      run_file_scene<float>();
+      end_phase("file");
+    }
+    if (config_.hard) {
+      report_.hard = measure_hard_rows(config_, [&](const std::string& what) { progress_->show(what); });
+      end_phase("hard");
+    }
+    if (!config_.sweep_n.empty()) {
+      run_sweep();
+      end_phase("sweep");
+    }
+    progress_->clear();
+  }
+
+ private:
+  // -- machine ---------------------------------------------------------------
+
+  void measure_machine() {
+    MachineInfo& m = report_.machine;
+    {
+      std::ifstream cpuinfo("/proc/cpuinfo");
+      std::string line;
+      while (std::getline(cpuinfo, line)) {
+        if (line.rfind("model name", 0) == 0) {
+          const std::size_t colon = line.find(':');
+          if (colon != std::string::npos) m.cpu = line.substr(colon + 2);
+          break;
+        }
+      }
+      std::ifstream loadavg("/proc/loadavg");
+      loadavg >> m.load_average;
+    }
+    m.hardware_threads = static_cast<unsigned>(sysconf(_SC_NPROCESSORS_ONLN));
+    m.l1d_bytes = cache_bytes(1);
+    m.l2_bytes = cache_bytes(2);
+    m.l3_bytes = cache_bytes(3);
+    {
+      std::string supported;
+      for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+        if (isa_supported(isa)) supported += std::string(supported.empty() ? "" : ", ") + to_string(isa);
+      }
+      m.simd_build = std::string("simd rows: ") + to_string(default_isa()) + " (this CPU has " + supported +
+                     "): " + std::to_string(simd_width<float>()) + " float / " + std::to_string(simd_width<double>()) +
+                     " double lanes";
+    }
+    progress_->show("isa auto: measuring the ISAs");
+    measure_isa_auto<float>(m.isa_auto);
+    measure_isa_auto<double>(m.isa_auto);
+    for (const int t : config_.threads) {
+      if (std::find(m.triad_threads.begin(), m.triad_threads.end(), t) != m.triad_threads.end()) continue;
+      progress_->show("triad bandwidth, " + std::to_string(t) + " thread(s)");
+      const TriadResult r = measure_triad(t, 0, config_.quick ? 3 : 10);
+      m.triad_threads.push_back(t);
+      m.triad_bytes_per_second.push_back(r.bytes_per_second);
+      m.triad_median_bytes_per_second.push_back(r.median_bytes_per_second);
+      m.triad_array_bytes = r.array_bytes;
+      triad_[t] = r.bytes_per_second;
+    }
+  }
+
+  /// What Isa::automatic picks for every model, accuracy and scene kind in
+  /// T (fastest_isa; the first call of each kind in this process measures).
+  template <class T>
+  static void measure_isa_auto(std::vector<IsaAutoPick>& picks) {
+    for (const Accuracy accuracy : {Accuracy::fast, Accuracy::accurate}) {
+      for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+        for (const bool scattered : {false, true}) {
+          const IsaMeasurement measured = isa_measurement<T>(model, accuracy, scattered);
+          IsaAutoPick pick;
+          pick.precision = precision_name<T>();
+          pick.model = to_string(model);
+          pick.accuracy = to_string(accuracy);
+          pick.scattered = scattered;
+          pick.isa = to_string(measured.fastest);
+          pick.calibration_seconds = measured.calibration_seconds;
+          for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+            const double seconds = measured.seconds[static_cast<int>(isa) - static_cast<int>(Isa::sse2)];
+            if (seconds > 0 && measured.contacts > 0) {
+              pick.ns_per_contact.emplace_back(to_string(isa), 1e9 * seconds / static_cast<double>(measured.contacts));
+            }
+          }
+          picks.push_back(std::move(pick));
+        }
+      }
+    }
+  }
+
+  [[nodiscard]] std::size_t expected_rows() const {
+    const std::size_t kernel = std::size_t{2} /*precisions*/ * 3 /*models*/ * kernel_variants().size();
+    const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
+    std::size_t rows = std::size_t{2} /*scenes*/ * 2 /*friction*/ * (kernel + slow);
+    if (!bullet_version().empty()) ++rows;
+    return rows;
+  }
+
+  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy) {
+    auto& slot = solvers_[{
+        (path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) + (accuracy == Accuracy::accurate ? 16 : 0), threads}];
+    if (!slot) {
+      SolverOptions options;
+      options.path = path;
+      options.threads = threads;
+      options.isa = isa;
+      options.accuracy = accuracy;
+      slot = std::make_unique<Solver>(options);
+    }
+    return *slot;
+  }
+
+  /// The kernel rows of one scene: the scalar path, the SIMD path (the
+  /// default ISA) and the SIMD path in the accurate mode (variant
+  /// "accurate") at every thread count, and SIMD on every other ISA the CPU
+  /// has at the first. The default ISA is default_isa() (COLLIDE_ISA, else
+  /// the widest), named, so that every row says which ISA it timed whatever
+  /// Isa::automatic would measure; the machine block shows those picks.
+  [[nodiscard]] std::vector<std::tuple<Path, int, Isa, Accuracy>> kernel_variants() const {
+    std::vector<std::tuple<Path, int, Isa, Accuracy>> v;
+    for (const auto& [path, accuracy] : kKernelVariants) {
+      for (const int threads : config_.threads) v.emplace_back(path, threads, default_isa(), accuracy);
+    }
+    for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
+      if (isa_supported(isa) && isa != default_isa()) {
+        v.emplace_back(Path::simd, config_.threads.front(), isa, Accuracy::fast);
+      }
+    }
+    return v;
+  }
+
+  // -- rows ------------------------------------------------------------------
+
+  ReportRow new_row(SceneKind kind, const char* variant, Model model, const char* precision, bool friction, int threads,
+                    std::size_t n) {
+    ReportRow row;
+    row.scene = scene_name(kind);
+    row.variant = variant;
+    row.model = to_string(model);
+    row.precision = precision;
+    row.friction = friction;
+    row.threads = threads;
+    row.n = n;
+    row.error_sample = sample_size();
+    return row;
+  }
+
+  void finish_speed(ReportRow& row, std::vector<double> seconds, std::size_t value_bytes, Model model) {
+    row.runs = static_cast<int>(seconds.size());
+    row.seconds = median(std::move(seconds));
+    row.collisions_per_second = row.seconds > 0 ? static_cast<double>(row.n) / row.seconds : 0;
+    row.bytes_per_collision = static_cast<double>(bytes_per_collision(model, value_bytes, row.friction));
+    const auto it = triad_.find(row.threads);
+    const double bw = it != triad_.end() ? it->second : 0;
+    row.bandwidth_fraction = bw > 0 ? row.collisions_per_second * row.bytes_per_collision / bw : 0;
+  }
+
+  [[nodiscard]] std::size_t sample_size() const {
+    return config_.quick ? std::min(config_.sample, std::min(config_.n, config_.debris_n)) : config_.sample;
+  }
+
+  void add(ReportRow row) {
+    progress_->step(row.scene + " " + row.precision + (row.friction ? " friction" : "") + ": " + row.variant + " " +
+                    row.model + ", " + std::to_string(row.threads) + " thread(s)");
+    report_.rows.push_back(std::move(row));
+  }
+
+  template <class T>
+  void run_scene(SceneKind kind, bool friction) {
+    const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
+    const std::size_t n = kind == SceneKind::pairs ? config_.n : config_.debris_n;
+    progress_->show(what + ": generating " + std::to_string(n) + " collisions");
+    Scene<T> scene = make_scene<T>(kind, n, friction, config_.seed);
+    Scene<T> sample = make_scene<T>(kind, sample_size(), friction, config_.seed);
+    measure_scene(kind, friction, scene, std::move(sample));
+  }
+
+  /// The caller's scene files: its own friction, and only the models it fits
+  /// (its bodies are the caller's, not reshaped for a model).
+  template <class T>
+  void run_file_scene() {
+    const std::string what = std::string("file ") + precision_name<T>();
+    progress_->show(what + ": reading " + config_.scene_bodies + " and " + config_.scene_contacts);
+    Scene<T> scene = read_scene_files<T>(config_.scene_bodies, config_.scene_contacts);
+    const Scene<T> sample = contact_prefix(scene, sample_size());
+    measure_scene(SceneKind::file, scene.contacts.view().mu != nullptr, scene, sample);
+  }
+
+  template <class T>
+  void measure_scene(SceneKind kind, bool friction, Scene<T>& scene, Scene<T> sample) {
+    const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
+    const std::size_t n = scene.contacts.size();
+    Schedule schedule, sample_schedule;
+    schedule.build(scene.contacts.view(), scene.bodies.view());
+    sample_schedule.build(sample.contacts.view(), sample.bodies.view());
+    ImpulseBuffer<T> impulses(scene.contacts.size());
+    SavedVelocities<T> saved;
+    const double eps = std::numeric_limits<T>::epsilon();
+
+    for (const Model model : kModels) {
+      if (kind == SceneKind::file) {
+        if (!model_misfit(model, scene.bodies.view(), scene.contacts.view()).empty()) continue;
+      } else if (model != Model::rigid) {
+        derive_model(scene, model);
+        derive_model(sample, model);
+      }
+      progress_->show(what + ": long double reference of the " + to_string(model) + " sample");
+      const ReferenceResult reference = reference_of(sample);
+      saved.save(scene.bodies.view(), scene.bodies.size());
+
+      if (model == Model::rigid) {
+        if constexpr (std::is_same_v<T, double>) {
+          slow_reference_rows(kind, friction, scene, sample, reference);
+        }
+        textbook_row(kind, friction, scene, saved, sample, reference);
+        if constexpr (std::is_same_v<T, float>) {
+          if (kind == SceneKind::pairs && !friction && !bullet_version().empty()) {
+            progress_->show(what + ": bullet");
+            ReportRow row = bullet_row(scene, config_.slow_n, sample, reference, config_.runs, triad_bw(1));
+            row.error_sample = sample.contacts.size();
+            add(std::move(row));
+            // Bullet wrote only its own copies; the scene is untouched.
+          }
+        }
+      }
+
+      for (const auto& [path, threads, isa, accuracy] : kernel_variants()) {
+        {
+          const Solver& s = solver(path, threads, isa, accuracy);
+          ReportRow row = new_row(kind, accuracy == Accuracy::accurate ? "accurate" : to_string(path), model,
+                                  precision_name<T>(), friction, threads, n);
+          row.simd = path == Path::simd;
+          progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
+          const BodyView<T> bodies = scene.bodies.view();
+          const ContactView<T> contacts = scene.contacts.view();
+          SolveStats stats;
+          std::vector<double> seconds = time_runs(
+              config_.runs, [&] { saved.restore(bodies); },
+              [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
+          row.lanes = stats.lanes;
+          row.isa = to_string(stats.isa);
+          row.layout = to_string(stats.layout);
+          finish_speed(row, std::move(seconds), sizeof(T), model);
+
+          // The error sample, solved by the same solver.
+          BodyBuffer<T> after = sample.bodies;
+          ImpulseBuffer<T> j(sample.contacts.size());
+          s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
+          fill_error<T>(row, std::as_const(j).view(), std::as_const(after).view(), reference, eps);
+          add(std::move(row));
+        }
+      }
+    }
+  }
+  double triad_bw(int threads) const {
+    const auto it = triad_.find(threads);
+    return it != triad_.end() ? it->second : 0;
+  }
+
+  /// The first slow_n contacts of a scene, with every body.
+  template <class T>
+  ContactView<T> slow_contacts(const Scene<T>& scene) const {
+    ContactView<T> c = scene.contacts.view();
+    c.count = std::min(c.count, config_.slow_n);
+    return c;
+  }
+
+  /// reference_solve<long double> and <double> on the rigid double scene.
+  void slow_reference_rows(SceneKind kind, bool friction, const Scene<double>& scene, const Scene<double>& sample,
+                           const ReferenceResult& reference) {
+    ContactView<double> contacts = slow_contacts(scene);
+    // Pairs touch only their own two bodies, so the slow prefix needs only
+    // the first 2 slow_n of them; debris contacts reach every body.
+    BodyView<const double> body_src = scene.bodies.view();
+    if (kind == SceneKind::pairs) body_src.count = std::min(body_src.count, 2 * contacts.count);
+    // A file's prefix may touch any of its bodies: only those it touches.
+    Scene<double> prefix;
+    if (kind == SceneKind::file) {
+      prefix = contact_prefix(scene, contacts.count);
+      body_src = std::as_const(prefix.bodies).view();
+      contacts = prefix.contacts.view();
+    }
+    {
+      // long double: the yardstick itself (its error is 0 by definition; the
+      // comparison still runs, as a check that it is deterministic).
+      BodyBuffer<L> bodies = convert_bodies<L>(body_src);
+      const ContactBuffer<L> ld_contacts = convert_contacts<L>(contacts);
+      ImpulseBuffer<L> j(ld_contacts.size());
+      SavedVelocities<L> saved;
+      saved.save(bodies.view(), bodies.size());
+      ReportRow row = new_row(kind, "reference", Model::rigid, "long double", friction, 1, contacts.count);
+      progress_->show(row.scene + ": reference long double");
+      std::vector<double> seconds = time_runs(
+          config_.runs, [&] { saved.restore(bodies.view()); },
+          [&] { reference_solve<L>(bodies.view(), ld_contacts.view(), j.view()); });
+      finish_speed(row, std::move(seconds), sizeof(L), Model::rigid);
+      if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
+
+      Scene<L> s = convert_scene<L>(sample);
+      ImpulseBuffer<L> sj(s.contacts.size());
+      reference_solve<L>(s.bodies.view(), s.contacts.view(), sj.view());
+      fill_error<L>(row, std::as_const(sj).view(), std::as_const(s.bodies).view(), reference,
+                    static_cast<double>(std::numeric_limits<L>::epsilon()));
+      add(std::move(row));
+    }
+    {
+      BodyBuffer<double> bodies = convert_bodies<double>(body_src);
+      ImpulseBuffer<double> j(contacts.count);
+      SavedVelocities<double> saved;
+      saved.save(bodies.view(), bodies.size());
+      ReportRow row = new_row(kind, "reference", Model::rigid, "double", friction, 1, contacts.count);
+      progress_->show(row.scene + ": reference double");
+      std::vector<double> seconds = time_runs(
+          config_.runs, [&] { saved.restore(bodies.view()); },
+          [&] { reference_solve<double>(bodies.view(), contacts, j.view()); });
+      finish_speed(row, std::move(seconds), sizeof(double), Model::rigid);
+      if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
+
+      BodyBuffer<double> after = sample.bodies;
+      ImpulseBuffer<double> sj(sample.contacts.size());
+      reference_solve<double>(after.view(), sample.contacts.view(), sj.view());
+      fill_error<double>(row, std::as_const(sj).view(), std::as_const(after).view(), reference,
+                         static_cast<double>(std::numeric_limits<double>::epsilon()));
+      add(std::move(row));
+    }
+  }
+
+  /// The plain textbook loop (textbook.hpp) on the rigid scene.
+  template <class T>
+  void textbook_row(SceneKind kind, bool friction, Scene<T>& scene, const SavedVelocities<T>& saved,
+                    const Scene<T>& sample, const ReferenceResult& reference) {
+    const ContactView<T> contacts = slow_contacts(scene);
+    const BodyView<T> bodies = scene.bodies.view();
+    ImpulseBuffer<T> j(contacts.count);
+    ReportRow row = new_row(kind, "textbook", Model::rigid, precision_name<T>(), friction, 1, contacts.count);
+    progress_->show(row.scene + ": textbook " + row.precision);
+    std::vector<double> seconds = time_runs(
+        config_.runs, [&] { saved.restore(bodies); }, [&] { textbook_solve<T>(bodies, contacts, j.view()); });
+    saved.restore(bodies);  // the kernel rows start from the generated state
+    finish_speed(row, std::move(seconds), sizeof(T), Model::rigid);
+    if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
+
+    BodyBuffer<T> after = sample.bodies;
+    ImpulseBuffer<T> sj(sample.contacts.size());
+    textbook_solve<T>(after.view(), sample.contacts.view(), sj.view());
+    fill_error<T>(row, std::as_const(sj).view(), std::as_const(after).view(), reference,
+                  static_cast<double>(std::numeric_limits<T>::epsilon()));
+    add(std::move(row));
+  }
+
+  // -- the N sweep -------------------------------------------------------------
+
+  void run_sweep() {
+    const int threads = *std::max_element(config_.threads.begin(), config_.threads.end());
+    const std::size_t largest = *std::max_element(config_.sweep_n.begin(), config_.sweep_n.end());
+    progress_->show("sweep: generating " + std::to_string(largest) + " pairs");
+    Scene<float> scene = make_scene<float>(SceneKind::pairs, largest, false, config_.seed);
+    const Solver& s = solver(Path::simd, threads, default_isa(), Accuracy::fast);
+    ImpulseBuffer<float> impulses(largest);
+    SavedVelocities<float> saved;
+    Schedule schedule;
+    for (const Model model : {Model::rigid, Model::particle}) {
+      if (model != Model::rigid) derive_model(scene, model);
+      for (const std::size_t n : config_.sweep_n) {
+        progress_->step("sweep: simd float " + std::string(to_string(model)) + ", " + std::to_string(n) + " pairs, " +
+                        std::to_string(threads) + " thread(s)");
+        BodyView<float> bodies = scene.bodies.view();
+        bodies.count = 2 * n;
+        ContactView<float> contacts = scene.contacts.view();
+        contacts.count = n;
+        ImpulseView<float> j = impulses.view();
+        j.count = n;
+        schedule.build(contacts, bodies);
+        saved.save(bodies, bodies.count);
+        auto restore = [&] { saved.restore(bodies); };
+        auto solve = [&] { s.solve(model, bodies, contacts, j, schedule); };
+        // One untimed run warms the caches and tells how many runs fit: about
+        // 0.2 s of timed runs for small N, at least 5, and 3 for the scenes of
+        // millions of pairs, whose runs are long and steady.
+        const double estimate = median(time_runs(1, restore, solve));
+        int runs = n >= 4000000 ? 3 : std::clamp(static_cast<int>(0.2 / std::max(estimate, 1e-7)), 5, 200);
+        if (config_.quick) runs = std::min(runs, 5);
+        SweepPoint p;
+        p.model = to_string(model);
+        p.n = n;
+        p.threads = threads;
+        p.runs = runs;
+        const double seconds = median(time_runs(runs, restore, solve));
+        p.collisions_per_second = static_cast<double>(n) / seconds;
+        p.bandwidth_fraction = p.collisions_per_second *
+                               static_cast<double>(bytes_per_collision(model, sizeof(float), false)) /
+                               triad_bw(threads);
+        report_.sweep.push_back(p);
+      }
+    }
+  }
+
+  const Config& config_;
+  Report& report_;
+  std::unique_ptr<Progress> progress_;
+  std::map<int, double> triad_;
+  std::map<std::pair<int, int>, std::unique_ptr<Solver>> solvers_;
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// The run.
+// ---------------------------------------------------------------------------
+
+std::vector<HardRow> measure_hard_report(const ReportOptions& options) {
+  if (options.runs < 1 || options.runs > 1000) throw std::invalid_argument("report: runs must be from 1 to 1000");
+  if (options.hard_n < 1 || options.hard_n > 0x7FFFFFFFULL) {
+    throw std::invalid_argument("report: hard_n must be from 1 to 2^31 - 1");
+  }
+  return measure_hard_rows(options, [](const std::string&) {});
+}
+
+Report measure_report(const ReportOptions& options) {
+  // The same ranges as the usage of `collide report`: pairs use 2n body ids,
+  // which are 32-bit.
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("report: ") + what);
+  };
+  require(options.n >= 1 && options.n <= 0x7FFFFFFFULL, "n must be from 1 to 2^31 - 1");
+  require(options.debris_n >= 1 && options.debris_n <= 0xFFFFFFFFULL, "debris_n must be from 1 to 2^32 - 1");
+  require(options.sample >= 1 && options.sample <= 0x7FFFFFFFULL, "sample must be from 1 to 2^31 - 1");
+  require(options.runs >= 1 && options.runs <= 1000, "runs must be from 1 to 1000");
+  require(!options.threads.empty(), "threads needs at least one count");
+  for (const int t : options.threads) require(t >= 1 && t <= 4096, "thread counts must be from 1 to 4096");
+  for (const std::size_t n : options.sweep_n) {
+    require(n >= 1 && n <= 0x7FFFFFFFULL, "sweep sizes must be from 1 to 2^31 - 1");
+  }
+  require(options.hard_n >= 1 && options.hard_n <= 0x7FFFFFFFULL, "hard_n must be from 1 to 2^31 - 1");
+  require(options.scene_bodies.empty() == options.scene_contacts.empty(),
+          "a scene of files needs both its bodies and its contacts file");
+  const auto t0 = Clock::now();
+  Report report;
+  report.n = options.n;
+  report.debris_n = options.debris_n;
+  report.error_sample =
+      options.quick ? std::min(options.sample, std::min(options.n, options.debris_n)) : options.sample;
+  report.quick = options.quick;
+  report.hard_n = options.hard ? options.hard_n : 0;
+  const std::string bullet = bullet_version();
+  report.peer_status = bullet.empty() ? "not built (libbullet-dev was not found by pkg-config at configure time)"
+                                      : bullet + ", btSequentialImpulseConstraintSolver";
+  Runner(options, report).run();
+  sort_report_rows(report);
+  report.wall_seconds = seconds_since(t0);
+  return report;
+}
+
+}  // namespace collide
