@@ -73,12 +73,17 @@ install(TARGETS ${COLLIDE_PACKAGE_LIBRARIES} EXPORT collideTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-# report.hpp belongs to the report engine (collide_report, not
-# installed: it links Eigen and optionally Bullet), so it is left out.
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/kernel/include/collide
+# One include/collide/ tree: the core's headers, collide/io/ and collide/eval/.
+set(_collide_header_roots ${PROJECT_SOURCE_DIR}/core/include/collide)
+if(TARGET collide_io)
+  list(APPEND _collide_header_roots ${PROJECT_SOURCE_DIR}/io/include/collide)
+endif()
+if(TARGET collide_eval)
+  list(APPEND _collide_header_roots ${PROJECT_SOURCE_DIR}/eval/include/collide)
+endif()
+install(DIRECTORY ${_collide_header_roots}
   DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-  FILES_MATCHING PATTERN "*.hpp"
-  PATTERN "report.hpp" EXCLUDE)
+  FILES_MATCHING PATTERN "*.hpp")
 
 # The command-line tool, when built. A shared build finds its library relative
 # to its own location, so the installed tree can be moved.
