@@ -34,6 +34,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import textwrap
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
@@ -115,6 +116,11 @@ def fmt_n(n: int | None) -> str:
     if n >= 1 << 10 and n % (1 << 10) == 0:
         return f"{n >> 10}Ki"
     return f"{n:,}"
+
+
+def para(*text: str) -> list[str]:
+    """One paragraph of prose, wrapped at 100 columns, then a blank line."""
+    return textwrap.wrap(" ".join(text), width=100, break_on_hyphens=False, break_long_words=False) + [""]
 
 
 def table(header: list[str], rows: list[list[str]], align: list[str] | None = None) -> list[str]:
@@ -382,12 +388,12 @@ def section_throughput(rows) -> list[str]:
             row.append(f"{r.rate / sc.rate:.1f}x" if r and sc and r.rate and sc.rate else "")
         out_rows.append(row)
     header, out_rows, align = drop_empty_columns(header, out_rows, align, keep=3)
-    lines = ["## Throughput by scene", "",
-             "Millions of contacts resolved per second (`solve/` and `textbook/` rows; the SIMD rows run the",
-             "instruction set chosen at run time). *bound*: the row's bytes per contact (the law's inputs and",
-             "outputs, `collide/traffic.hpp`) moved at its rate, over the triad bandwidth at the same thread",
-             "count; above 1 the data came from cache. *textbook*: the plain one-contact-at-a-time Eigen loop.",
-             ""]
+    lines = ["## Throughput by scene", ""] + para(
+        "Millions of contacts resolved per second (`solve/` and `textbook/` rows; the SIMD rows run the",
+        "instruction set chosen at run time). *bound*: the row's bytes per contact (the law's inputs and",
+        "outputs, `collide/eval/traffic.hpp`) moved at its rate, over the triad bandwidth at the same",
+        "thread count; above 1 the data came from cache. *textbook*: the plain one-contact-at-a-time",
+        "Eigen loop.")
     return lines + table(header, out_rows, align) + [""]
 
 
@@ -415,10 +421,10 @@ def section_models(rows) -> list[str]:
             fmt_rate(w.rate) if w else "", fmt_ratio(f.rate / w.rate) if f and w and w.rate else "",
         ])
     header, out_rows, align = drop_empty_columns(header, out_rows, align, keep=6)
-    lines = ["## Body models and accuracy modes", "",
-             "SIMD path, millions of contacts per second (`model/` rows: the fast mode; `accurate/` rows: the",
-             "accurate mode; `twin/` rows: the model's memory-only twin, the same loads and stores without the",
-             "law). Each model runs on the scene reshaped to fit it (docs/report.md, \"The scenes\").", ""]
+    lines = ["## Body models and accuracy modes", ""] + para(
+        "SIMD path, millions of contacts per second (`model/` rows: the fast mode; `accurate/` rows: the",
+        "accurate mode; `twin/` rows: the model's memory-only twin, the same loads and stores without the",
+        "law). Each model runs on the scene reshaped to fit it ([report.md](report.md), \"The scenes\").")
     return lines + table(header, out_rows, align) + [""]
 
 
@@ -450,10 +456,10 @@ def section_isa(rows) -> list[str]:
             w = find(isa_rows, scene=scene, friction=fric, precision=prec, n=n, threads=t, kind=widest)
             row.append(f"{w.rate / sc.rate:.1f}x" if w and sc and sc.rate else "")
         out_rows.append(row)
-    lines = ["## Instruction sets", "",
-             "The SIMD path forced to each instruction set the CPU has (`isa/` rows), beside the scalar path",
-             "(one lane) and `auto`, the run-time choice (in parentheses, the set it ran), in millions of",
-             "contacts per second. Results are the same bits on every set.", ""]
+    lines = ["## Instruction sets", ""] + para(
+        "The SIMD path forced to each instruction set the CPU has (`isa/` rows), beside the scalar path",
+        "(one lane) and `auto`, the run-time choice (in parentheses, the set it ran), in millions of",
+        "contacts per second. Results are the same bits on every set.")
     return lines + table(header, out_rows, align) + [""]
 
 
@@ -485,12 +491,12 @@ def section_layout(rows) -> list[str]:
         row.append(fmt_ratio(rec.rate / p.rate) if p and rec and p.rate else "")
         out_rows.append(row)
     header, out_rows, align = drop_empty_columns(header, out_rows, align, keep=6)
-    lines = ["## Body layouts", "",
-             "Millions of contacts per second by body layout (`layout/` rows): *soa* solves the caller's",
-             "arrays in place, *packed* is SoA input that the solver packs into records and unpacks around",
-             "the solve (included in the time), *records* is the caller's packed records",
-             "(`collide/packed.hpp`). *pairs, same model* is the `model/` row of the streaming scene at the",
-             "same size and thread count, the scattered scene's ceiling.", ""]
+    lines = ["## Body layouts", ""] + para(
+        "Millions of contacts per second by body layout (`layout/` rows): *soa* solves the caller's",
+        "arrays in place, *packed* is SoA input that the solver packs into records and unpacks around",
+        "the solve (included in the time), *records* is the caller's packed records",
+        "(`collide/packed.hpp`). *pairs, same model* is the `model/` row of the streaming scene at the",
+        "same size and thread count, the scattered scene's ceiling.")
     return lines + table(header, out_rows, align) + [""]
 
 
@@ -501,9 +507,9 @@ def section_schedule(rows) -> list[str]:
     sched.sort(key=lambda r: (scene_order(r.scene), r.precision != "float", r.n or 0))
     out_rows = [[r.scene, r.precision, fmt_n(r.n), fmt_rate(r.rate), f"{r.batches:.0f}" if r.batches else "",
                  f"{r.sched_bytes:.1f}" if r.sched_bytes else ""] for r in sched]
-    lines = ["## Schedule", "",
-             "`Schedule::build` alone: millions of contacts scheduled per second, the batches (dependency",
-             "levels) of the scene, and the schedule's memory in bytes per contact.", ""]
+    lines = ["## Schedule", ""] + para(
+        "`Schedule::build` alone: millions of contacts scheduled per second, the batches (dependency",
+        "levels) of the scene, and the schedule's memory in bytes per contact.")
     return lines + table(["scene", "precision", "N", "M contacts/s", "batches", "bytes/contact"], out_rows,
                          ["l", "l", "r", "r", "r", "r"]) + [""]
 
@@ -566,14 +572,16 @@ def section_report(report: dict) -> list[str]:
     groups: dict[tuple, list] = {}
     for r in rows:
         groups.setdefault((r.get("scene"), bool(r.get("friction"))), []).append(r)
-    lines = ["## Speed against error (`collide report`)", "",
-             "Every variant of one scene solves the same contacts; *err* is the impulse error against",
-             "`reference_solve<long double>` on the error sample "
-             f"({report.get('error_sample', 'n/a'):,} contacts) in units of eps times the contact's impulse",
-             f"scale (the documented bound is {report.get('error_bound_eps', 64)}); *bw* is the share of the triad",
-             "bandwidth bound at the row's thread count; *rel* the plain relative error. Kernel rows are shown",
-             "at the largest thread count and the instruction set chosen at run time; the report's JSON has",
-             "every row (docs/report.md explains the columns).", ""]
+    sample = report.get("error_sample")
+    lines = ["## Speed against error (`collide report`)", ""] + para(
+        "Every variant of one scene solves the same contacts; *err* is the impulse error against",
+        "`reference_solve<long double>` on the error sample",
+        f"({sample:,} contacts)" if isinstance(sample, int) else "",
+        "in units of eps times the contact's impulse scale (the documented bound is",
+        f"{report.get('error_bound_eps', 64)}); *bw* is the share of the triad bandwidth bound at the row's",
+        "thread count; *rel* the plain relative error. Kernel rows are shown at the largest thread count",
+        "and the instruction set chosen at run time; the report's JSON has every row",
+        "([report.md](report.md) explains the columns).")
     header = ["variant", "precision", "model", "isa", "layout", "threads", "n", "Mcoll/s", "bw", "max err",
               "p99 err", "max rel", "note"]
     align = ["l", "l", "l", "l", "l", "r", "r", "r", "r", "r", "r", "r", "l"]
@@ -624,11 +632,11 @@ def section_hard(report: dict) -> list[str]:
                 speed_rows.append([p, model, fmt_rate(f["collisions_per_second"] / 1e6),
                                    fmt_rate(a["collisions_per_second"] / 1e6),
                                    fmt_ratio(a["collisions_per_second"] / f["collisions_per_second"])])
-    lines = ["## Hard scenes (`collide report --hard`)", "",
-             f"Worst figure over the body models each scene fits ({report.get('hard_n', 'n/a')} pairs per pair",
-             "family; SIMD path, one thread). *err*: eps-units of the impulse scale, the fast mode's target is",
-             f"{report.get('impulse_error_target_eps', 2)}; *ulps*: plain relative error of J, the accurate mode's"
-             f" bound is {report.get('accurate_error_ulps', 8)}.", ""]
+    lines = ["## Hard scenes (`collide report --hard`)", ""] + para(
+        f"Worst figure over the body models each scene fits ({report.get('hard_n', 'n/a')} pairs per pair",
+        "family; SIMD path, one thread). *err*: eps-units of the impulse scale, the fast mode's target is",
+        f"{report.get('impulse_error_target_eps', 2)}; *ulps*: plain relative error of J, the accurate mode's",
+        f"bound is {report.get('accurate_error_ulps', 8)}.")
     lines += table(header, out_rows, ["l"] + ["r"] * len(cols)) + [""]
     if speed_rows:
         lines += [f"Speed of the two modes on the `{first}` scene, in cache (millions of contacts per second):",
@@ -654,9 +662,9 @@ def section_sweep(report: dict) -> list[str]:
                        (fmt_rate(s["collisions_per_second"] / 1e6) if s and s.get("collisions_per_second") else ""))
         out_rows.append(row)
     t = sweep[0].get("threads")
-    lines = ["## Throughput against N", "",
-             f"SIMD float kernel on the first N pairs of one scene, {t} threads: millions of contacts per second",
-             "(fraction of the bandwidth bound).", ""]
+    lines = ["## Throughput against N", ""] + para(
+        f"SIMD float kernel on the first N pairs of one scene, {t} threads: millions of contacts per second",
+        "(fraction of the bandwidth bound).")
     return lines + table(["N"] + models, out_rows, ["r"] * (1 + len(models))) + [""]
 
 
@@ -680,9 +688,9 @@ def section_isa_auto(report: dict) -> list[str]:
                                                       p.get("scene")) == (prec, acc, m, "scattered")), "")
             row.append(f"{s} / {c}")
         out_rows.append(row)
-    lines = ["## Run-time instruction set choice", "",
-             "What `--isa auto` picked on this machine for each kind of solve (streaming / scattered scene),",
-             "measured once per process at the first solve of each kind (the report's machine block).", ""]
+    lines = ["## Run-time instruction set choice", ""] + para(
+        "What `--isa auto` picked on this machine for each kind of solve (streaming / scattered scene),",
+        "measured once per process at the first solve of each kind (the report's machine block).")
     return lines + table(["precision", "accuracy"] + models, out_rows, ["l", "l"] + ["l"] * len(models)) + [""]
 
 
@@ -692,13 +700,12 @@ def section_isa_auto(report: dict) -> list[str]:
 
 
 def header_lines(context, rows, report, cpu, commit, bench_cmd, report_cmd, date_override=None) -> list[str]:
-    lines = [GENERATED_NOTE, "", "# Performance", "",
-             "Generated by `scripts/perf_tables.py` from one run of `collide_bench` "
-             + ("and `collide report` " if report else "")
-             + "on one machine; do not edit by hand. Compare ratios within",
-             "one run: absolute rates move with the machine and its load. How the rows are measured:",
-             "`bench/main.cpp` (its header comment) and [report.md](report.md); what the figures led to:",
-             "[decisions/](decisions/).", ""]
+    lines = [GENERATED_NOTE, "", "# Performance", ""] + para(
+        "Generated by `scripts/perf_tables.py` from one run of `collide_bench`",
+        "and `collide report`" if report else "",
+        "on one machine; do not edit by hand. Compare ratios within one run: absolute rates move with",
+        "the machine and its load. How the rows are measured: `bench/main.cpp` (its header comment) and",
+        "[report.md](report.md); what the figures led to: [decisions/](decisions/).")
     have, ran = isa_summary(rows)
     facts = [("machine", machine_line(context, report, cpu))]
     if have or ran or report:
@@ -710,7 +717,8 @@ def header_lines(context, rows, report, cpu, commit, bench_cmd, report_cmd, date
                 f"{', '.join(sorted(v, key=ISAS.index))} on {k}" for k, v in
                 sorted(ran.items(), key=lambda kv: scene_order(kv[0]))) + " (chosen at run time)")
         if report and report.get("machine", {}).get("simd"):
-            isa_text.append("report: " + report["machine"]["simd"])
+            simd = re.sub(r"^simd rows:\s*", "", report["machine"]["simd"])
+            isa_text.append("the report's SIMD rows ran " + simd)
         facts.append(("instruction sets", "; ".join(isa_text)))
     tri = triad(rows)
     if tri:
@@ -726,7 +734,7 @@ def header_lines(context, rows, report, cpu, commit, bench_cmd, report_cmd, date
         facts.append(("load average", load))
     date = date_override or context.get("date") or datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     facts.append(("date", date))
-    facts.append(("commit", f"`{commit}`" if commit else "unknown"))
+    facts.append(("commit", (f"`{commit}`" if commit else "unknown") + " (the tree's HEAD when the page was generated)"))
     if bench_cmd:
         facts.append(("benchmark", f"`{bench_cmd}`"))
     if report_cmd:
@@ -765,51 +773,66 @@ def render(bench_path: Path | None, report_path: Path | None, cpu=None, commit=N
 
 
 def readme_block(bench_path: Path | None, report_path: Path | None, cpu=None, commit=None) -> str | None:
-    """The short table README.md shows: SIMD throughput of the two main scenes
-    at the streaming size, and the report's pairs rows against the peer."""
+    """The short tables README.md shows: SIMD throughput of the scenes at the
+    largest size the benchmark ran, and the report's pairs rows against the
+    reference, the textbook loop and the peer."""
     context, rows = load_bench(bench_path) if bench_path else ({}, [])
     report = None
     if report_path:
         with open(report_path) as f:
             report = json.load(f)
-    out_rows = []
+    lines = []
     solve = select(rows, family="solve", kind="simd")
     if solve:
         n = max(r.n for r in solve if r.n)
         t = max(r.threads for r in solve if r.threads)
+        body = []
         for scene in sorted({r.scene for r in solve}, key=scene_order):
             for prec in ("float", "double"):
                 r = find(solve, scene=scene, friction=False, precision=prec, n=n, threads=t)
                 if r:
-                    out_rows.append([f"{scene}, rigid, SIMD, {t} threads", prec, fmt_n(n), fmt_rate(r.rate),
-                                     fmt_ratio(r.bw_frac) if r.bw_frac else "", ""])
+                    body.append([scene, prec, fmt_rate(r.rate), fmt_ratio(r.bw_frac) if r.bw_frac else ""])
+        if body:
+            lines += [f"`collide_bench`, SIMD path, {fmt_n(n)} contacts, {t} threads, rigid bodies:", ""]
+            lines += table(["scene", "precision", "M contacts/s", "of the bandwidth bound"], body,
+                           ["l", "l", "r", "r"]) + [""]
     if report:
         pairs = [r for r in report.get("rows", []) if r.get("scene") == "pairs" and not r.get("friction")]
         chosen = report_group_rows(pairs)
         wanted = [("reference", "long double", "rigid"), ("textbook", "float", "rigid"),
                   ("bullet", "float", "rigid"), ("simd", "float", "rigid"), ("simd", "double", "rigid"),
                   ("accurate", "float", "rigid"), ("simd", "float", "particle")]
+        names = {"reference": "reference", "textbook": "textbook loop", "bullet": "Bullet (peer)",
+                 "simd": "SIMD", "accurate": "SIMD, accurate mode"}
+        body = []
         for v, p, m in wanted:
             r = next((x for x in chosen if (x.get("variant"), x.get("precision"), x.get("model")) == (v, p, m)), None)
-            if not r:
+            if not r or not r.get("collisions_per_second"):
                 continue
-            name = {"reference": "reference", "textbook": "textbook loop", "bullet": "Bullet (peer)",
-                    "simd": "SIMD", "accurate": "SIMD, accurate mode"}[v]
             bw = r.get("bandwidth_fraction")
-            out_rows.append([f"report: {name}, {m}, {r.get('threads')} thread{'s' if r.get('threads', 1) > 1 else ''}",
-                             p, fmt_n(r.get("n")), fmt_rate(r["collisions_per_second"] / 1e6),
-                             fmt_ratio(bw) if bw else "", fmt_err(r.get("max_err_eps"))])
-    if not out_rows:
+            body.append([names[v], p, m, str(r.get("threads", "")), fmt_rate(r["collisions_per_second"] / 1e6),
+                         fmt_ratio(bw) if bw else "", fmt_err(r.get("max_err_eps"))])
+        if body:
+            n = max((r.get("n") or 0 for r in pairs), default=0)
+            lines += [f"`collide report`, pairs without friction ({fmt_n(n)} contacts; error in eps-units of the",
+                      f"impulse scale, bound {report.get('error_bound_eps', 64)}):", ""]
+            lines += table(["variant", "precision", "model", "threads", "M contacts/s", "of the bound", "max err"],
+                           body, ["l", "l", "l", "r", "r", "r", "r"]) + [""]
+    if not lines:
         return None
+    tri = triad(rows)
     date = (context.get("date") or "")[:10]
-    lines = [README_BEGIN,
-             f"Machine: {machine_line(context, report, cpu or cpu_model())}; commit `{commit or git_commit()}`"
-             + (f", {date}" if date else "") + ". Generated; all rows in",
-             "[docs/performance.md](docs/performance.md).", ""]
-    lines += table(["row", "precision", "N", "M contacts/s", "of bound", "max err (eps-units)"], out_rows,
-                   ["l", "l", "r", "r", "r", "r"])
-    lines.append(README_END)
-    return "\n".join(lines)
+    facts = [machine_line(context, report, cpu or cpu_model())]
+    if tri:
+        facts.append("triad " + ", ".join(f"{g:.1f}" for _, g in sorted(tri.items())) + " GB/s on "
+                     + " / ".join(str(t) for t in sorted(tri)) + " threads")
+    load = context.get("load_avg")
+    if load:
+        facts.append(f"load average {load[0]:.1f}")
+    facts.append(f"commit `{commit or git_commit()}`" + (f", {date}" if date else ""))
+    head = para("Machine:", "; ".join(facts) + ".",
+                "Generated by `scripts/perf_tables.py`; every row is in [docs/performance.md](docs/performance.md).")
+    return "\n".join([README_BEGIN] + head + lines[:-1] + [README_END])
 
 
 def update_readme(readme: Path, block: str) -> bool:
