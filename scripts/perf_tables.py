@@ -56,9 +56,10 @@ PRESETS = {
         "bench": ["--sizes=65536,4194304", "--benchmark_min_time=0.05", "--benchmark_filter=" + SHORT_BENCH_FILTER],
         "report": ["--n", "200000", "--runs", "3", "--hard"],
     },
-    # Everything the benchmark and the report do by default (tens of minutes).
+    # Every row of the benchmark and the report at their default settings, and
+    # the report's hard section: tens of minutes, the page for an idle machine.
     "full": {
-        "bench": ["--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true"],
+        "bench": [],
         "report": ["--hard"],
     },
 }
@@ -1020,7 +1021,8 @@ def main(argv=None) -> int:
     p.add_argument("--bench", default=str(REPO / "build" / "collide_bench"), help="collide_bench (with --run)")
     p.add_argument("--collide", default=str(REPO / "build" / "collide"), help="collide (with --run)")
     p.add_argument("--preset", choices=sorted(PRESETS), default="short",
-                   help="what --run measures: short (default, a couple of minutes) or full (tens of minutes)")
+                   help="what --run measures: short (default, a couple of minutes on 2 cores) or full (every "
+                        "row at the default settings, tens of minutes)")
     p.add_argument("--bench-args", help="collide_bench arguments instead of the preset's (one string)")
     p.add_argument("--report-args", help="collide report arguments instead of the preset's (one string)")
     p.add_argument("--json-dir", help="keep the run's JSON here (default: a new temporary directory)")
