@@ -1,5 +1,5 @@
-// lane_layer.cpp - how the lane layer was chosen (README, "Choosing the lane
-// layer"). The same arithmetic, the inverse effective mass of one body's
+// lane_layer.cpp - how the lane layer was chosen
+// (docs/decisions/0003-the-lane-layer.md). The same arithmetic, the inverse effective mass of one body's
 // lever arm and the normal impulse over SoA arrays,
 //     h = R^T (r x n),  K = 1/m + h . (invI * h),  j = -(1 + e) vn / K,
 // written once over a lane type and run with three candidates:

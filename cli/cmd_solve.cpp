@@ -217,7 +217,7 @@ int solve_scene(const SolveRequest& req) {
     record.emplace_back("read_seconds", read_seconds);
     record.emplace_back("write_seconds", write_seconds);
     // File I/O against everything solve does: for large scenes the CSV text,
-    // not the kernel, is where the time goes (README, "Command line").
+    // not the kernel, is where the time goes (docs/decisions/0011-csv-scene-files.md).
     const double io_seconds = read_seconds + write_seconds;
     record.emplace_back("io_seconds", io_seconds);
     // Against the kernel time as reported: without the ISA calibration,

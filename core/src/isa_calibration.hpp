@@ -6,7 +6,7 @@
 // Why measure: the widest ISA is not always the fastest. A CPU that splits
 // 512-bit operations in two can run the streaming pairs scene slower with
 // AVX-512 than with AVX2 and the scattered debris scene faster (the
-// measurements: docs/decisions/). Every
+// measurements: docs/decisions/0006-run-time-instruction-set-choice.md). Every
 // ISA gives the same bits (kernel_table.hpp), so the choice can be made on
 // speed alone, and the only way to know the speed on a given CPU is to run it.
 //

@@ -14,7 +14,7 @@
 // fixed-size arrays because it is width-generic by construction, has masks and
 // `where`, costs no dependency, and runs as fast as raw AVX2 intrinsics and
 // Eigen fixed-size arrays on the same arithmetic (bench/lane_layer.cpp
-// measures the three; the figures are in docs/decisions/).
+// measures the three; docs/decisions/0003-the-lane-layer.md has the figures).
 //
 // AVX2 has gathers but no scatters, and its vgatherdps is slower on AMD
 // cores than W scalar loads and inserts (the pairs scene lost a fifth with

@@ -16,16 +16,12 @@
 //    contacts ahead make predictable: prefetching them keeps enough misses in
 //    flight. It counts nothing per level: a histogram increment there is a
 //    store-to-load chain whenever neighbours share a level (every contact on
-//    the pairs scene), and cost a fifth of the pass (measured).
+//    the pairs scene), and cost a fifth of the pass.
 //    Every index is checked (< the body count, a != b) before it is used:
 //    each block of kCheckBlock contacts is screened branch-free, then
 //    assigned, and a contact that fails throws before any body word of it
-//    is read or written. A branch per contact inside the loop cost 7% of the
-//    build on debris and 12 to 16% on pairs at 2M contacts; the blocks (with
-//    the next block's indices prefetched and the screen's AVX2 clone) cost
-//    5 to 6% and 6 to 8%, and 3% and 4 to 5% at 200k (float, one thread, min
-//    of 20 alternated with the unchecked build, whose own repeats agree
-//    within 2%; AMD EPYC, GCC 12, on a loaded machine).
+//    is read or written: a branch per contact inside the loop costs about
+//    twice as much as the blocks (docs/decisions/0015).
 //    Both arrays hold one byte per body and per contact while the levels fit
 //    (fewer than 254 batches: every scene but long chains): the body table of
 //    1M bodies then fits in L2, and every pass streams a quarter of the
@@ -44,8 +40,8 @@
 //
 // The level pass is bound by the random reads of the body table: a prefetch
 // 16 contacts ahead hides them (8 leaves misses exposed, 16 to 64 are alike),
-// and the table is kept in bytes. The measurements behind these choices are
-// in docs/decisions/; the bench rows schedule/<scene>/... time the whole
+// and the table is kept in bytes (docs/decisions/0015-the-schedules-level-pass.md
+// has the measurements); the bench rows schedule/<scene>/... time the whole
 // build.
 #include "collide/schedule.hpp"
 

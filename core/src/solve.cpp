@@ -289,7 +289,7 @@ std::size_t scattered_contacts(const Schedule& schedule) {
 /// Whether SoA input is packed. Packing reads every body once and writes v,
 /// w back once (streaming, parallel); it pays when the scattered contacts
 /// would otherwise touch a line per component per body at random. Measured
-/// (README, "Performance"): at a quarter as many scattered contacts as
+/// (docs/decisions/0005-packed-records-for-scattered-contacts.md): at a quarter as many scattered contacts as
 /// bodies the two cost about the same; below that, or in scenes that stream
 /// (pairs), the SoA arrays are used in place.
 

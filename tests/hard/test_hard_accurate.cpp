@@ -28,7 +28,7 @@
 //   those values, through the library and through `collide solve`; and a
 //   normal rounded to unit length in T before the law (what a reader that
 //   normalised on storing did) is far outside the target there.
-// The "[accurate]" lines are the figures of docs/collision-law.md.
+// The "[accurate]" lines are the figures of docs/decisions/0007-the-accurate-mode.md.
 #include <cmath>
 #include <cstddef>
 #include <iomanip>

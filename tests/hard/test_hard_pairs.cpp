@@ -19,7 +19,8 @@
 //   bodies and non-approaching contacts untouched bit for bit, J = 0 between
 //   two immovable bodies, e = 0 stops the normal motion, e = 1 keeps the
 //   energy, no contact creates momentum or energy).
-// The "[hard]" lines printed are the figures of docs/collision-law.md.
+// The "[hard]" lines printed are the figures of
+// docs/decisions/0008-the-impulse-scale.md.
 #include <cmath>
 #include <cstdint>
 #include <limits>

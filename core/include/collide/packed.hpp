@@ -35,7 +35,8 @@
 // It pays in cache (rigid double most); on large scattered scenes the
 // solve is bound by the contacts' lines, read level by level, not by the
 // records (the memory-only twin of the same accesses, bench/packed_twin.cpp,
-// runs at the kernel's speed). The measurements: docs/decisions/.
+// runs at the kernel's speed). The measurements:
+// docs/decisions/0005-packed-records-for-scattered-contacts.md.
 //
 // The layout holds the same values as the SoA views, in the same units, and
 // converts to and from them exactly (a copy, no arithmetic): a caller may

@@ -150,7 +150,7 @@ struct ExternalArena;
 /// there are bodies; SolverOptions::layout can force either way) is packed
 /// into the solver's own buffer, solved there, and v, w written back: the
 /// same bits as solving in place, several times faster on scattered scenes
-/// (README, "Performance"). The buffer grows to the largest scene seen and is
+/// (docs/decisions/0005-packed-records-for-scattered-contacts.md). The buffer grows to the largest scene seen and is
 /// kept; solves that pack on one Solver run one at a time. The only state
 /// shared between solvers is the process's cache of fastest_isa() answers:
 /// two solvers never share threads unless their caller shares an arena.
