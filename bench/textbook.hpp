@@ -1,14 +1,15 @@
 // bench/textbook.hpp - the baseline: the loop a user would write from the law.
 //
-// The loop itself lives in eval/src/report/textbook.hpp, shared with `collide
-// report` (its textbook rows), so that the benchmarks and the report measure
-// the same baseline. This header keeps the benchmarks' name for it.
+// The loop is collide::textbook_solve (collide/eval/reference.hpp): the
+// reference's transcription of the law without its error analysis, in the
+// scene's precision, which `collide report` times as its textbook rows too.
+// This header keeps the benchmarks' name for it.
 #pragma once
 
-#include "../eval/src/report/textbook.hpp"
+#include "collide/eval/reference.hpp"
 
 namespace collide_bench {
 
-using collide::report_detail::textbook_solve;
+using collide::textbook_solve;
 
 }  // namespace collide_bench

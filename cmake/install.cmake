@@ -9,15 +9,15 @@
 #   core alone needs neither (and a build with -DCOLLIDE_BUILD_IO=OFF installs
 #   the core alone).
 # * What a consumer needs is exactly the public link interface:
-#     - the headers (C++17, no TBB, no Eigen: both are used only in .cpp files);
+#     - the headers (C++17, no TBB: it is used only in .cpp files);
 #     - for a static archive, TBB (and for io, libdeflate) as well, because an
 #       archive cannot carry its own dependencies. The exported targets say so
 #       ($<LINK_ONLY:TBB::tbb>, $<LINK_ONLY:PkgConfig::LIBDEFLATE>, which CMake
 #       adds for a PRIVATE dependency of a static library), so the config file
 #       calls find_dependency(TBB) and finds libdeflate through pkg-config in
-#       that case only.
-#       Eigen never reaches the interface (it is a $<BUILD_INTERFACE>
-#       dependency).
+#       that case only. No library uses Eigen (only the tests and the
+#       benchmarks do), and tests/package checks that nothing installed asks
+#       for it.
 # * Three ways in, the same names: find_package(collide) and add_subdirectory
 #   both give collide::collide, collide::io and collide::eval; pkg-config gives
 #   collide.pc, collide-io.pc and collide-eval.pc (each Requires the one below

@@ -393,8 +393,8 @@ def section_throughput(rows) -> list[str]:
         "Millions of contacts resolved per second (`solve/` and `textbook/` rows; the SIMD rows run the",
         "instruction set chosen at run time). *bound*: the row's bytes per contact (the law's inputs and",
         "outputs, `collide/eval/traffic.hpp`) moved at its rate, over the triad bandwidth at the same",
-        "thread count; above 1 the data came from cache. *textbook*: the plain one-contact-at-a-time",
-        "Eigen loop.")
+        "thread count; above 1 the data came from cache. *textbook*: the law as written, one contact at",
+        "a time (`textbook_solve`).")
     return lines + table(header, out_rows, align) + [""]
 
 

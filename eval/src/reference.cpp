@@ -17,6 +17,10 @@
 // 5e-20 rounding by 1e7, far above double's ulp), and Eigen has no numeric
 // traits for __float128. Every operation is a correctly rounded +, -, *, /
 // or sqrt in S.
+//
+// One transcription: textbook_solve, the report's and the benchmarks'
+// baseline, is this code without the error analysis, in the scene's own
+// precision.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -155,11 +159,14 @@ struct RefBody {
   }
 };
 
-}  // namespace
 
-template <class S>
-void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
-                     ReferenceContact<S>* diagnostics) {
+/// The law for every contact in input order. With kErrorAnalysis, also the
+/// scales the kernels' errors are measured against (ReferenceContact); without
+/// it, the law alone: the same operations on the same values, so the two give
+/// the same J and velocities.
+template <class S, bool kErrorAnalysis>
+void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
+               ReferenceContact<S>* diagnostics) {
   using V3 = Vec<S>;
   // The uncertainty each body's velocities inherit from the contacts applied
   // to it before (linear [m/s] and angular [rad/s], in units of C eps): a
@@ -171,8 +178,8 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
   // contact of a chain, not only about the first one (without it, 1 contact
   // in 100k of the debris scene, 6 deep in a chain, was 80 eps off in float,
   // and the reference evaluated in double 57).
-  std::vector<S> inherited_v(bodies.count, S(0));
-  std::vector<S> inherited_w(bodies.count, S(0));
+  std::vector<S> inherited_v(kErrorAnalysis ? bodies.count : 0, S(0));
+  std::vector<S> inherited_w(kErrorAnalysis ? bodies.count : 0, S(0));
   for (std::size_t k = 0; k < contacts.count; ++k) {
     const std::size_t ia = contacts.a[k];
     const std::size_t ib = contacts.b[k];
@@ -223,14 +230,16 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     ReferenceContact<S> d;
     const V3 u = relative_velocity();
     d.vn = u.dot(n);
-    d.speed_scale = speed_scale();
     d.k_n = inv_effective_mass(n);
     V3 j = V3::Zero();
     // The scale is defined for every contact with a movable body, approaching
     // or not: a kernel that rounds a near-zero vn to the other side owes an
     // error measured against it.
-    if (d.k_n != S(0)) {
-      d.impulse_scale = (S(1) + e) * (d.speed_scale + ref_abs(d.vn) * lever_sensitivity(n) / d.k_n) / d.k_n;
+    if constexpr (kErrorAnalysis) {
+      d.speed_scale = speed_scale();
+      if (d.k_n != S(0)) {
+        d.impulse_scale = (S(1) + e) * (d.speed_scale + ref_abs(d.vn) * lever_sensitivity(n) / d.k_n) / d.k_n;
+      }
     }
     if (d.vn < S(0) && d.k_n != S(0)) {
       d.jn = -(S(1) + e) * d.vn / d.k_n;
@@ -268,12 +277,15 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
           // reference_solve<double>: the double state after the normal
           // impulse was off by 14 eps of |u'| (docs/collision-law.md, "The
           // friction step after the normal impulse").
-          const S after_normal = d.impulse_scale * compliance_times(n).norm() +
-                                 d.jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
-          d.impulse_scale =
-              (S(1) + mu) * d.impulse_scale +
-              (d.speed_scale + speed_scale() + after_normal) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
-              d.jt * lever_sensitivity(t) / d.k_t;
+          if constexpr (kErrorAnalysis) {
+            const S after_normal =
+                d.impulse_scale * compliance_times(n).norm() +
+                d.jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
+            d.impulse_scale =
+                (S(1) + mu) * d.impulse_scale +
+                (d.speed_scale + speed_scale() + after_normal) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
+                d.jt * lever_sensitivity(t) / d.k_t;
+          }
           apply(-d.jt * t);
           j -= d.jt * t;
         }
@@ -284,15 +296,32 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
     impulses.j.x[k] = j.x();
     impulses.j.y[k] = j.y();
     impulses.j.z[k] = j.z();
-    // Whether or not the reference applied an impulse: a kernel may have
-    // applied one of up to C eps s where vn was within rounding of 0.
-    inherited_v[ia] += d.impulse_scale * a.inv_mass;
-    inherited_w[ia] += d.impulse_scale * a.inv_inertia_max * ra.norm();
-    inherited_v[ib] += d.impulse_scale * b.inv_mass;
-    inherited_w[ib] += d.impulse_scale * b.inv_inertia_max * rb.norm();
-    if (diagnostics) diagnostics[k] = d;
+    if constexpr (kErrorAnalysis) {
+      // Whether or not the reference applied an impulse: a kernel may have
+      // applied one of up to C eps s where vn was within rounding of 0.
+      inherited_v[ia] += d.impulse_scale * a.inv_mass;
+      inherited_w[ia] += d.impulse_scale * a.inv_inertia_max * ra.norm();
+      inherited_v[ib] += d.impulse_scale * b.inv_mass;
+      inherited_w[ib] += d.impulse_scale * b.inv_inertia_max * rb.norm();
+      if (diagnostics) diagnostics[k] = d;
+    }
   }
 }
+
+}  // namespace
+
+template <class S>
+void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
+                     ReferenceContact<S>* diagnostics) {
+  solve_law<S, true>(bodies, contacts, impulses, diagnostics);
+}
+
+template <class T>
+void textbook_solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
+  solve_law<T, false>(bodies, contacts, impulses, nullptr);
+}
+template void textbook_solve<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&);
+template void textbook_solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&);
 
 template void reference_solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&,
                                       ReferenceContact<double>*);

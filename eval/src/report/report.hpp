@@ -14,7 +14,7 @@
 // * The peer (Bullet) lives in its own translation unit behind
 //   COLLIDE_WITH_BULLET (src/report/bullet_row.cpp), so the report builds
 //   and runs without it. The engine is its own library (collide_report), so
-//   the core library links neither Bullet nor Eigen.
+//   the core library never links Bullet.
 #pragma once
 
 #include <cstddef>

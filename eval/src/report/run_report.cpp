@@ -77,7 +77,6 @@
 #include "collide/solve.hpp"
 #include "collide/eval/traffic.hpp"
 #include "measure.hpp"
-#include "textbook.hpp"
 
 namespace collide {
 
@@ -588,7 +587,7 @@ class Runner {
     }
   }
 
-  /// The plain textbook loop (textbook.hpp) on the rigid scene.
+  /// The plain textbook loop (textbook_solve, collide/eval/reference.hpp) on the rigid scene.
   template <class T>
   void textbook_row(SceneKind kind, bool friction, Scene<T>& scene, const SavedVelocities<T>& saved,
                     const Scene<T>& sample, const ReferenceResult& reference) {

@@ -66,4 +66,18 @@ extern template void reference_solve<__float128>(const BodyView<__float128>&, co
                                                  const ImpulseView<__float128>&, ReferenceContact<__float128>*);
 #endif
 
+/// The same transcription of the law without the error analysis, in the
+/// scene's own precision: the obvious loop a user would write from the law
+/// (one contact at a time, in input order, world frame; no lanes, schedule
+/// or threads). `collide report` and the benchmarks time it as their
+/// "textbook" baseline, so that what the kernels buy is measured against the
+/// law as written, not against a second transcription of it.
+template <class T>
+void textbook_solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses);
+
+extern template void textbook_solve<float>(const BodyView<float>&, const ContactView<float>&,
+                                           const ImpulseView<float>&);
+extern template void textbook_solve<double>(const BodyView<double>&, const ContactView<double>&,
+                                            const ImpulseView<double>&);
+
 }  // namespace collide
