@@ -588,16 +588,24 @@ bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) no
 }
 
 template <class T>
+std::optional<RowDefect> first_body_defect(const BodyColumns<T>& columns) {
+  const std::size_t n = columns.size();
+  if (detail::screen_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); })) {
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::optional<Defect> defect = body_defect(columns.record(i))) return RowDefect{i, std::move(*defect)};
+  }
+  return std::nullopt;  // not reached: bodies_ok gives body_ok's verdicts
+}
+
+template <class T>
 BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table) {
   using Range = oneapi::tbb::blocked_range<std::size_t>;
-  // The rules first, in parallel and without messages (body_ok); a table
-  // that breaks one goes through set(), which names the first defect as it
-  // always has.
-  const bool ok =
-      detail::screen_chunks(table.size(), [&](std::size_t i0, std::size_t i1) { return bodies_ok(table, i0, i1); });
-  if (!ok) {
-    BodyBuffer<T> named(table.size());
-    for (std::size_t i = 0; i < table.size(); ++i) named.set(i, table.record(i));  // throws at the first defect
+  // The rules first, in parallel and without messages; the first body that
+  // breaks one goes through set(), which names its defect as it always has.
+  if (const std::optional<RowDefect> bad = first_body_defect(table)) {
+    BodyBuffer<T>(bad->row + 1).set(bad->row, table.record(bad->row));  // throws
   }
   BodyBuffer<T> bodies(table.size());
   // Column by column: q, p, v and w are copied as they are, m and I
@@ -961,6 +969,7 @@ void append_contact_row(std::string& out, const ContactRecord<T>& contact) {
   template BodyTable<T> read_bodies<T>(const std::string&);                                     \
   template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                              \
   template bool bodies_ok<T>(const BodyColumns<T>&, std::size_t, std::size_t) noexcept;         \
+  template std::optional<RowDefect> first_body_defect<T>(const BodyColumns<T>&);                \
   template void inverses_of<T>(const BodyColumns<T>&, T*, const Vec3Array<T>&);                 \
   template ContactBuffer<T> parse_contacts<T>(std::string_view, std::string_view, std::size_t); \
   template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);                  \

@@ -266,14 +266,8 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
     out.columns_.column[k] = real_column<T>(archive, *members[k], precision, out.table_.column[k], in_place);
     out.mapped_ |= in_place;
   }
-  const BodyColumns<T>& columns = out.columns_;
-  const bool screened =
-      detail::screen_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); });
-  const std::size_t bad =
-      screened ? n : first_failing_row(n, [&](std::size_t i) { return body_ok(columns.record(i)); });
-  if (bad < n) {
-    const auto defect = body_defect(columns.record(bad));  // body_ok's verdict, with its reason
-    throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
+  if (const std::optional<RowDefect> bad = first_body_defect(out.columns_)) {
+    throw SceneError(archive.file_name(), 0, bad->row, std::string(bad->defect.column), bad->defect.reason);
   }
   return out;
 }

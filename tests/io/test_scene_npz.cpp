@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -329,6 +330,31 @@ void contact_screen_clears_only_valid_contacts() {
 TEST(SceneNpzRules, ContactScreenClearsOnlyValidContacts) {
   contact_screen_clears_only_valid_contacts<float>();
   contact_screen_clears_only_valid_contacts<double>();
+}
+
+TEST(SceneNpzRules, FirstBodyDefectIsTheFirstRowWithItsReason) {
+  // Past the screen's grain, so it runs in chunks: the first row that
+  // breaks a rule is named whatever the chunking, with body_defect's column
+  // and reason, even when a later row breaks a rule of an earlier column.
+  constexpr std::size_t kN = 200000;
+  Bodies<float> b(kN);
+  collide::BodyColumns<float> c;
+  c.count = kN;
+  for (std::size_t j = 0; j < 17; ++j) c.column[j] = b.col[j].data();
+  EXPECT_FALSE(collide::first_body_defect(c).has_value());
+  b.col[0][kN - 5] = -1;                                   // m, a late row
+  b.col[13][kN - 9] = std::numeric_limits<float>::quiet_NaN();  // vz, an earlier row
+  const std::optional<collide::RowDefect> d = collide::first_body_defect(c);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->row, kN - 9);
+  EXPECT_EQ(d->defect.column, "vz");
+  EXPECT_EQ(d->defect.reason, "NaN is not allowed");
+  b.col[13][kN - 9] = 0;
+  const std::optional<collide::RowDefect> m = collide::first_body_defect(c);
+  ASSERT_TRUE(m.has_value());
+  EXPECT_EQ(m->row, kN - 5);
+  EXPECT_EQ(m->defect.column, "m");
+  EXPECT_EQ(m->defect.reason, "mass must be > 0, got -1");
 }
 
 TEST_F(SceneNpzTest, DefectFoundInALargeFileAtItsRow) {

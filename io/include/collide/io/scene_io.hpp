@@ -37,6 +37,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -137,6 +138,22 @@ struct BodyColumns {
 /// defect of a body.
 template <class T>
 bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) noexcept;
+
+/// The defect of one row of a table: the 0-based row, and the column and
+/// reason of the rule it breaks (collide/rules.hpp).
+struct RowDefect {
+  std::size_t row = 0;
+  Defect defect;
+};
+
+/// The first body of `columns` that breaks a rule, with body_defect's
+/// column and reason, or nothing. bodies_ok screens every body in parallel
+/// chunks; only a failed screen is scanned, body by body in order, so the
+/// body named does not depend on threads. What the binary scene loader, the
+/// CSV tables' to_body_buffer and the Python module's from_physical check
+/// columns in physical units with.
+template <class T>
+std::optional<RowDefect> first_body_defect(const BodyColumns<T>& columns);
 
 /// A table's columns as BodyColumns (valid while the table lives unchanged).
 template <class T>

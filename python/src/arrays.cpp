@@ -1,0 +1,82 @@
+// python/src/arrays.cpp - the checks of one NumPy array argument (arrays.hpp):
+// type, dtype, shape, layout, alignment and write access, each refused with
+// a TypeError that names the array; lengths with a ValueError.
+#include "arrays.hpp"
+
+namespace collide::python {
+
+std::string text(const py::handle& h) { return py::str(h).cast<std::string>(); }
+
+const char* dtype_name(Dtype d) { return d == Dtype::f32 ? "float32" : "float64"; }
+
+py::dtype numpy_dtype(Dtype d) { return d == Dtype::f32 ? py::dtype::of<float>() : py::dtype::of<double>(); }
+
+Dtype parse_dtype(const py::object& dtype) {
+  const py::dtype d = py::dtype::from_args(dtype);
+  if (d.equal(py::dtype::of<float>())) return Dtype::f32;
+  if (d.equal(py::dtype::of<double>())) return Dtype::f64;
+  throw py::type_error("dtype must be numpy.float32 or numpy.float64, got " + text(dtype));
+}
+
+Dtype scene_dtype(const std::string& what, const py::handle& obj) {
+  if (!py::isinstance<py::array>(obj)) {
+    throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
+  }
+  const py::dtype d = py::reinterpret_borrow<py::array>(obj).dtype();
+  if (d.equal(py::dtype::of<float>())) return Dtype::f32;
+  if (d.equal(py::dtype::of<double>())) return Dtype::f64;
+  throw py::type_error(what + " has dtype " + text(d) + ", expected float32 or float64");
+}
+
+std::string shape_text(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t k = 0; k < a.ndim(); ++k) {
+    if (k > 0) s += ", ";
+    s += std::to_string(a.shape(k));
+  }
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+bool writeable(const py::array& a) { return (a.flags() & py::detail::npy_api::NPY_ARRAY_WRITEABLE_) != 0; }
+
+void set_read_only(py::array& a) {
+  py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+}
+
+py::array checked_array(const std::string& owner, const char* name, const py::handle& obj, const py::dtype& dtype,
+                        const char* dtype_text, int rows, bool must_write) {
+  const std::string what = owner + "." + name;
+  if (!py::isinstance<py::array>(obj)) {
+    throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
+  }
+  py::array a = py::reinterpret_borrow<py::array>(obj);
+  if (!a.dtype().equal(dtype)) {
+    throw py::type_error(what + " has dtype " + text(a.dtype()) + ", expected " + dtype_text);
+  }
+  const bool shape_ok = rows == 0 ? a.ndim() == 1 : (a.ndim() == 2 && a.shape(0) == rows);
+  if (!shape_ok) {
+    throw py::type_error(what + " has shape " + shape_text(a) + ", expected " +
+                         (rows == 0 ? std::string("(N,)") : "(" + std::to_string(rows) + ", N)"));
+  }
+  // C-contiguous, or (for a (rows, N) array) each row contiguous with the
+  // rows apart: what a scene file loaded in place gives (collide.load), its
+  // columns at one stride in the mapping.
+  const auto item = static_cast<py::ssize_t>(a.itemsize());
+  const bool rows_contiguous = rows != 0 && a.shape(1) > 0 && a.strides(1) == item && a.strides(0) % item == 0 &&
+                               a.strides(0) >= a.shape(1) * item;
+  if ((a.flags() & py::array::c_style) == 0 && !rows_contiguous) {
+    throw py::type_error(what + " must be C-contiguous (numpy.ascontiguousarray makes a contiguous copy)");
+  }
+  if ((a.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_) == 0) throw py::type_error(what + " must be aligned");
+  if (must_write && !writeable(a)) throw py::type_error(what + " must be writeable: the solve updates it in place");
+  return a;
+}
+
+void require_length(const std::string& owner, const char* name, const py::array& a, std::size_t n, const char* first) {
+  if (length(a) != n) {
+    throw py::value_error(owner + "." + name + " has " + std::to_string(length(a)) + " elements, " + first + " has " +
+                          std::to_string(n));
+  }
+}
+
+}  // namespace collide::python

@@ -1,0 +1,226 @@
+// python/src/bind_scene.cpp - collide.Bodies and collide.Contacts, and the
+// scenes made from Python: generated (collide.generate), from physical
+// units (collide.from_physical), and the questions a scene answers about
+// its model (choose_model, model_misfit).
+//
+// Design notes
+// ------------
+// * The constructors check only the arrays (arrays.hpp): dtype, shape,
+//   layout, lengths. Values are the library's to judge, when they are used.
+// * from_physical applies the library's rules for physical units
+//   (collide/rules.hpp) through the scene files' own column screen
+//   (first_body_defect, collide/io/scene_io.hpp): the arrays are the
+//   seventeen columns of a bodies file, with no copy, so Python refuses
+//   what the file readers refuse, with their reason; the message names the
+//   body and the column, "from_physical: body 3, column 'm': mass must be
+//   > 0, got -1". The inverses are the readers' too (inverses_of).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "bindings.hpp"
+#include "collide/io/generate.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/io/scene_io.hpp"
+#include "scene.hpp"
+
+namespace collide::python {
+
+Bodies::Bodies(const py::object& inv_mass_in, const py::object& inv_inertia_in, const py::object& q_in,
+               const py::object& p_in, const py::object& v_in, const py::object& w_in) {
+  const std::string owner = "bodies";
+  dtype = scene_dtype("bodies.inv_mass", inv_mass_in);
+  const py::dtype dt = numpy_dtype(dtype);
+  const char* dn = dtype_name(dtype);
+  inv_mass = checked_array(owner, "inv_mass", inv_mass_in, dt, dn, 0, false);
+  inv_inertia = checked_array(owner, "inv_inertia", inv_inertia_in, dt, dn, 3, false);
+  q = checked_array(owner, "q", q_in, dt, dn, 4, false);
+  p = checked_array(owner, "p", p_in, dt, dn, 3, false);
+  v = checked_array(owner, "v", v_in, dt, dn, 3, true);
+  w = checked_array(owner, "w", w_in, dt, dn, 3, true);
+  count = length(inv_mass);
+  for (const auto& [name, a] : {std::pair<const char*, const py::array*>{"inv_inertia", &inv_inertia},
+                                {"q", &q},
+                                {"p", &p},
+                                {"v", &v},
+                                {"w", &w}}) {
+    require_length(owner, name, *a, count, "inv_mass");
+  }
+  if (count > std::numeric_limits<BodyIndex>::max()) throw py::value_error("bodies: more than 2^32 - 1 bodies");
+}
+
+Contacts::Contacts(const py::object& a_in, const py::object& b_in, const py::object& c_in, const py::object& n_in,
+                   const py::object& e_in, double uniform_e_in, const py::object& mu_in) {
+  const std::string owner = "contacts";
+  const py::dtype u32 = py::dtype::of<std::uint32_t>();
+  a = checked_array(owner, "a", a_in, u32, "uint32", 0, false);
+  b = checked_array(owner, "b", b_in, u32, "uint32", 0, false);
+  dtype = scene_dtype("contacts.c", c_in);
+  const py::dtype dt = numpy_dtype(dtype);
+  const char* dn = dtype_name(dtype);
+  c = checked_array(owner, "c", c_in, dt, dn, 3, false);
+  n = checked_array(owner, "n", n_in, dt, dn, 3, false);
+  if (!e_in.is_none()) e = checked_array(owner, "e", e_in, dt, dn, 0, false);
+  if (!mu_in.is_none()) mu = checked_array(owner, "mu", mu_in, dt, dn, 0, false);
+  uniform_e = uniform_e_in;
+  count = length(a);
+  require_length(owner, "b", b, count, "a");
+  require_length(owner, "c", c, count, "a");
+  require_length(owner, "n", n, count, "a");
+  if (e) require_length(owner, "e", *e, count, "a");
+  if (mu) require_length(owner, "mu", *mu, count, "a");
+}
+
+std::optional<Model> parse_model(const std::string& s) {
+  if (s == "auto") return std::nullopt;
+  if (s == "rigid") return Model::rigid;
+  if (s == "sphere") return Model::sphere;
+  if (s == "particle") return Model::particle;
+  throw py::value_error("model must be 'auto', 'rigid', 'sphere' or 'particle', got '" + s + "'");
+}
+
+Model parse_named_model(const std::string& s, const char* who) {
+  const std::optional<Model> m = parse_model(s);
+  if (!m) throw py::value_error(std::string(who) + " needs a model: 'rigid', 'sphere' or 'particle'");
+  return *m;
+}
+
+namespace {
+
+py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
+                      bool friction, const py::object& dtype_in) {
+  const Dtype d = parse_dtype(dtype_in);
+  if (kind != "pairs" && kind != "debris") {
+    throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  }
+  if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
+  GenerateOptions o;
+  o.seed = seed;
+  o.friction = friction;
+  o.model = parse_named_model(model, "generate");
+  return with_dtype(d, [&](auto tag) {
+    using T = decltype(tag);
+    Scene<T> s;
+    {
+      py::gil_scoped_release release;
+      s = kind == "pairs" ? generate_pairs<T>(n, o) : generate_debris<T>(n, o);
+    }
+    return scene_objects<T>(std::as_const(s.bodies).view(), s.contacts.view(), d);
+  });
+}
+
+/// Bodies from physical units: mass (inf = immovable), principal moments
+/// (inf = no rotation about that axis), any non-zero quaternion (stored as
+/// given: the law normalises it).
+py::object from_physical_py(const py::object& m_in, const py::object& inertia_in, const py::object& q_in,
+                            const py::object& p_in, const py::object& v_in, const py::object& w_in,
+                            const py::object& dtype_in) {
+  const Dtype d = parse_dtype(dtype_in);
+  const py::dtype dt = numpy_dtype(d);
+  const char* dn = dtype_name(d);
+  const std::string owner = "from_physical";
+  const py::array m = checked_array(owner, "m", m_in, dt, dn, 0, false);
+  const py::array I = checked_array(owner, "inertia", inertia_in, dt, dn, 3, false);
+  const py::array q = checked_array(owner, "q", q_in, dt, dn, 4, false);
+  const py::array p = checked_array(owner, "p", p_in, dt, dn, 3, false);
+  const py::array v = checked_array(owner, "v", v_in, dt, dn, 3, false);
+  const py::array w = checked_array(owner, "w", w_in, dt, dn, 3, false);
+  const std::size_t n = length(m);
+  for (const auto& [name, a] :
+       {std::pair<const char*, const py::array*>{"inertia", &I}, {"q", &q}, {"p", &p}, {"v", &v}, {"w", &w}}) {
+    require_length(owner, name, *a, n, "m");
+  }
+  return with_dtype(d, [&](auto tag) {
+    using T = decltype(tag);
+    // The arrays are the columns of a bodies file (kBodyColumns order).
+    BodyColumns<T> columns;
+    columns.count = n;
+    columns.column = {data<T>(m),   row<T>(I, 0), row<T>(I, 1), row<T>(I, 2), row<T>(q, 0), row<T>(q, 1),
+                      row<T>(q, 2), row<T>(q, 3), row<T>(p, 0), row<T>(p, 1), row<T>(p, 2), row<T>(v, 0),
+                      row<T>(v, 1), row<T>(v, 2), row<T>(w, 0), row<T>(w, 1), row<T>(w, 2)};
+    py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
+    py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
+    std::optional<RowDefect> defect;
+    {
+      T* const im = data<T>(inv_mass);
+      const Vec3Array<T> ii = vec3<T>(inv_inertia);
+      py::gil_scoped_release release;
+      defect = first_body_defect(columns);
+      if (!defect) inverses_of(columns, im, ii);
+    }
+    if (defect) {
+      throw py::value_error(owner + ": body " + std::to_string(defect->row) + ", column '" +
+                            std::string(defect->defect.column) + "': " + defect->defect.reason);
+    }
+    const auto copy = [&](std::size_t first, std::size_t rows) {
+      return copy_rows<T>(dt, columns.column.data() + first, rows, n);
+    };
+    return py::cast(Bodies(inv_mass, inv_inertia, copy(4, 4), copy(8, 3), copy(11, 3), copy(14, 3)));
+  });
+}
+
+/// model "auto" of a solve: the cheapest model that fits the validated scene.
+std::string choose_model_py(const Bodies& bodies, const Contacts& contacts) {
+  require_same_dtype(bodies, contacts);
+  return with_dtype(bodies.dtype, [&](auto tag) {
+    using T = decltype(tag);
+    validate_or_throw<T>(bodies, contacts);
+    return std::string(to_string(choose_model(bodies.view<T>(), contacts.view<T>())));
+  });
+}
+
+/// Why `model` does not fit the scene, or "".
+std::string model_misfit_py(const Bodies& bodies, const Contacts& contacts, const std::string& model) {
+  require_same_dtype(bodies, contacts);
+  const Model mm = parse_named_model(model, "model_misfit");
+  return with_dtype(bodies.dtype, [&](auto tag) {
+    using T = decltype(tag);
+    return model_misfit(mm, bodies.view<T>(), contacts.view<T>());
+  });
+}
+
+}  // namespace
+
+void register_scene(py::module_& m) {
+  py::class_<Bodies>(m, "Bodies")
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
+                    const py::object&>(),
+           py::arg("inv_mass"), py::arg("inv_inertia"), py::arg("q"), py::arg("p"), py::arg("v"), py::arg("w"))
+      .def_readonly("inv_mass", &Bodies::inv_mass)
+      .def_readonly("inv_inertia", &Bodies::inv_inertia)
+      .def_readonly("q", &Bodies::q)
+      .def_readonly("p", &Bodies::p)
+      .def_readonly("v", &Bodies::v)
+      .def_readonly("w", &Bodies::w)
+      .def_property_readonly("dtype", [](const Bodies& b) { return numpy_dtype(b.dtype); })
+      .def("__len__", [](const Bodies& b) { return b.count; });
+
+  py::class_<Contacts>(m, "Contacts")
+      .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
+                    double, const py::object&>(),
+           py::arg("a"), py::arg("b"), py::arg("c"), py::arg("n"), py::arg("e") = py::none(),
+           py::arg("uniform_e") = 1.0, py::arg("mu") = py::none())
+      .def_readonly("a", &Contacts::a)
+      .def_readonly("b", &Contacts::b)
+      .def_readonly("c", &Contacts::c)
+      .def_readonly("n", &Contacts::n)
+      .def_property_readonly("e", [](const Contacts& c) { return c.e ? py::object(*c.e) : py::none(); })
+      .def_property_readonly("mu", [](const Contacts& c) { return c.mu ? py::object(*c.mu) : py::none(); })
+      .def_readonly("uniform_e", &Contacts::uniform_e)
+      .def_property_readonly("dtype", [](const Contacts& c) { return numpy_dtype(c.dtype); })
+      .def("__len__", [](const Contacts& c) { return c.count; });
+
+  m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
+        py::arg("model") = "rigid", py::arg("friction") = false, py::arg("dtype") = py::none());
+  m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
+        py::arg("w"), py::arg("dtype"));
+  m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"));
+  m.def("model_misfit", &model_misfit_py, py::arg("bodies"), py::arg("contacts"), py::arg("model"));
+}
+
+}  // namespace collide::python

@@ -1,0 +1,316 @@
+// python/src/bind_solve.cpp - collide.Solver, collide.Schedule, the
+// reference solve and the error measure, and the instruction-set queries.
+//
+// Design notes
+// ------------
+// * Everything is checked before anything is written: layouts (by the
+//   Bodies/Contacts/PackedBodies constructors and impulse_array), values
+//   (the library's validate(), or only the indices when check=False), the
+//   model and the schedule's size. The library's std::invalid_argument
+//   (Schedule::build, Solver::solve, parse_isa, parse_accuracy) arrives as
+//   ValueError with the library's message (module.cpp).
+// * check=False skips validate() and the model-fit check for frame loops
+//   that validated their scene once; the indices are still checked, so no
+//   index outside the arrays ever reaches the kernel: by Schedule::build when
+//   the solve builds its schedule, by validate_indices() beside a schedule
+//   the caller built earlier.
+// * One generic solve for both kinds of bodies (Bodies, PackedBodies): the
+//   steps that differ are overloads (scene.hpp, packed_bodies.hpp).
+// * The GIL is released around every long C++ call (schedule, solve,
+//   reference). The ndarrays stay referenced by the Bodies and Contacts
+//   objects (and the call's arguments) meanwhile.
+// * The statistics dict is collide::solve_record (collide/eval/check.hpp),
+//   the record `collide solve --stats` prints, and the error per contact is
+//   collide::impulse_errors_eps, what `--check` summarises.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "bindings.hpp"
+#include "collide/eval/check.hpp"
+#include "collide/eval/error_bound.hpp"
+#include "collide/eval/reference.hpp"
+#include "collide/io/scene.hpp"
+#include "collide/isa.hpp"
+#include "packed_bodies.hpp"
+#include "scene.hpp"
+
+namespace collide::python {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+Path parse_path(const std::string& s) {
+  if (s == "simd") return Path::simd;
+  if (s == "scalar") return Path::scalar;
+  throw py::value_error("path must be 'simd' or 'scalar', got '" + s + "'");
+}
+
+SolverOptions solver_options(const std::string& path, int threads, const py::object& isa, const std::string& accuracy) {
+  SolverOptions o;
+  o.path = parse_path(path);
+  if (threads < 0 || threads > 4096) throw py::value_error("threads must be from 0 (all) to 4096");
+  o.threads = threads;
+  std::optional<std::string> isa_name;
+  try {
+    if (!isa.is_none()) isa_name = isa.cast<std::string>();
+  } catch (const py::cast_error&) {
+    throw py::type_error("isa must be a string or None");
+  }
+  if (isa_name) o.isa = parse_isa(*isa_name);
+  o.accuracy = parse_accuracy(accuracy);
+  return o;
+}
+
+/// The impulse output: `out` when given (checked like an input), else a new array.
+py::array impulse_array(const py::object& out, Dtype dtype, std::size_t m) {
+  if (out.is_none()) return new_array(dtype, {3, static_cast<py::ssize_t>(m)});
+  py::array j = checked_array("solve", "out", out, numpy_dtype(dtype), dtype_name(dtype), 3, true);
+  require_length("solve", "out", j, m, "contacts.a");
+  return j;
+}
+
+/// A schedule built for one set of contacts and bodies; reusable while the
+/// indices and inverse masses do not change (a frame loop over velocities).
+struct PySchedule {
+  Schedule schedule;
+  std::size_t contacts = 0, bodies = 0;
+  double build_seconds = 0;
+
+  /// Schedule::build checks every index (std::invalid_argument naming the
+  /// first bad one: a ValueError).
+  template <class T, class B>
+  void build(const B& b, const Contacts& c) {
+    const ContactView<T> cv = c.view<T>();
+    const auto t0 = Clock::now();
+    {
+      py::gil_scoped_release release;
+      build_schedule<T>(schedule, cv, b);
+    }
+    build_seconds = seconds_since(t0);
+    contacts = c.count;
+    bodies = b.count;
+  }
+
+  /// A schedule over validated input (it reads the indices).
+  template <class B>
+  static std::unique_ptr<PySchedule> make(const B& bodies, const Contacts& contacts) {
+    require_same_dtype(bodies, contacts);
+    auto s = std::make_unique<PySchedule>();
+    with_dtype(bodies.dtype, [&](auto tag) {
+      using T = decltype(tag);
+      validate_or_throw<T>(bodies, contacts);
+      s->build<T>(bodies, contacts);
+    });
+    return s;
+  }
+};
+
+py::dict to_dict(const StatRecord& record) {
+  py::dict d;
+  for (const auto& entry : record) {
+    // Not a structured binding: clang 14 cannot capture one in the lambda.
+    const std::string& key = entry.first;
+    std::visit([&](const auto& x) { d[py::str(key)] = py::cast(x); }, entry.second);
+  }
+  return d;
+}
+
+struct PySolver {
+  std::unique_ptr<Solver> solver;
+
+  PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy)
+      : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy))) {}
+
+  template <class T, class B>
+  py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
+                    const py::object& out, bool check, bool impacts) {
+    const std::optional<Model> requested = parse_model(model_name);
+    py::array j = impulse_array(out, bodies.dtype, contacts.count);
+    T* jp = data<T>(j);
+    const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
+    const ContactView<T> cv = contacts.view<T>();
+    // Unchecked values are the caller's word; indices never are (memory
+    // safety). A schedule built here checks every index in its own pass
+    // (Schedule::build throws std::invalid_argument, a ValueError here); a
+    // schedule built earlier vouches only for the indices it saw then, so
+    // the indices are checked again beside it.
+    if (check) {
+      if (const Validation v = validate_values(bodies, cv, jv); !v) throw py::value_error(v.message);
+    } else if (schedule != nullptr) {
+      if (const Validation v = validate_indices(cv.a, cv.b, cv.count, bodies.count); !v) {
+        throw py::value_error(v.message);
+      }
+    }
+    PySchedule own;
+    if (schedule == nullptr) {
+      own.build<T>(bodies, contacts);  // before the model choice, which reads the bodies of every contact
+      schedule = &own;
+    } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
+      throw py::value_error("schedule was built for " + std::to_string(schedule->contacts) + " contacts and " +
+                            std::to_string(schedule->bodies) + " bodies, not " + std::to_string(contacts.count) +
+                            " and " + std::to_string(bodies.count));
+    }
+    const Model model = solve_model<T>(bodies, cv, requested, check);
+    SolveStats stats;
+    double kernel_seconds = 0;
+    {
+      py::gil_scoped_release release;
+      const auto t0 = Clock::now();
+      stats = run_solve<T>(*solver, model, bodies, cv, jv, schedule->schedule);
+      kernel_seconds = seconds_since(t0);
+    }
+    // impacts=False: no pass over J (at a million contacts it costs 5-10% of
+    // a particle solve); the record is built over no impulses and the key
+    // set to None.
+    const ImpulseView<const T> jc{impacts ? jv.count : 0, {jv.j.x, jv.j.y, jv.j.z}};
+    py::dict d =
+        to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));
+    if (!impacts) d["impacts"] = py::none();
+    return py::make_tuple(j, d);
+  }
+
+  template <class B>
+  py::tuple solve(const B& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
+                  const py::object& out, bool check, bool impacts) {
+    require_same_dtype(bodies, contacts);
+    return with_dtype(bodies.dtype, [&](auto tag) {
+      return solve_t<decltype(tag)>(bodies, contacts, model, schedule, out, check, impacts);
+    });
+  }
+};
+
+// ---------------------------------------------------------------------------
+// The reference and the error measure.
+// ---------------------------------------------------------------------------
+
+/// reference_solve<long double> on an exact copy of the inputs: the caller's
+/// bodies are not modified.
+struct Reference {
+  ImpulseBuffer<long double> impulses;
+  std::vector<ReferenceContact<long double>> diagnostics;
+  BodyBuffer<long double> after;
+  Dtype dtype = Dtype::f64;
+
+  py::array j_array() const {
+    const ImpulseView<const long double> j = impulses.view();
+    return rows_as_double(j.j.x, j.j.y, j.j.z, j.count);
+  }
+  py::array vec_array(bool angular) const {
+    const BodyView<const long double> b = after.view();
+    const Vec3Array<const long double> x = angular ? b.w : b.v;
+    return rows_as_double(x.x, x.y, x.z, b.count);
+  }
+  py::array impulse_scale() const {
+    py::array_t<double> out(static_cast<py::ssize_t>(diagnostics.size()));
+    double* o = out.mutable_data();
+    for (std::size_t k = 0; k < diagnostics.size(); ++k) o[k] = static_cast<double>(diagnostics[k].impulse_scale);
+    return out;
+  }
+  static py::array rows_as_double(const long double* x, const long double* y, const long double* z, std::size_t n) {
+    py::array_t<double> out({py::ssize_t{3}, static_cast<py::ssize_t>(n)});
+    double* o = out.mutable_data();
+    for (std::size_t k = 0; k < n; ++k) {
+      o[k] = static_cast<double>(x[k]);
+      o[n + k] = static_cast<double>(y[k]);
+      o[2 * n + k] = static_cast<double>(z[k]);
+    }
+    return out;
+  }
+};
+
+std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts) {
+  require_same_dtype(bodies, contacts);
+  return with_dtype(bodies.dtype, [&](auto tag) {
+    using T = decltype(tag);
+    validate_or_throw<T>(bodies, contacts);
+    auto r = std::make_shared<Reference>();
+    r->dtype = bodies.dtype;
+    const BodyView<T> bv = bodies.view<T>();
+    const ContactView<T> cv = contacts.view<T>();
+    py::gil_scoped_release release;
+    r->after = convert_bodies<long double>(const_view(bv));
+    const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
+    r->impulses.resize(contacts.count);
+    r->diagnostics.resize(contacts.count);
+    reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data());
+    return r;
+  });
+}
+
+py::array impulse_error_py(const py::object& j_in, const Reference& ref) {
+  const Dtype dtype = scene_dtype("impulse_error.J", j_in);
+  const py::array j = checked_array("impulse_error", "J", j_in, numpy_dtype(dtype), "float32 or float64", 3, false);
+  require_length("impulse_error", "J", j, ref.impulses.size(), "the reference");
+  return with_dtype(dtype, [&](auto tag) {
+    using T = decltype(tag);
+    const std::size_t m = length(j);
+    const T* p = data<T>(j);
+    const ImpulseView<const T> jv{m, {p, p + m, p + 2 * m}};
+    const std::vector<double> errors = impulse_errors_eps<T>(jv, ref.impulses.view(), ref.diagnostics);
+    py::array_t<double> out(static_cast<py::ssize_t>(m));
+    std::copy(errors.begin(), errors.end(), out.mutable_data());
+    return out;
+  });
+}
+
+}  // namespace
+
+void register_solve(py::module_& m) {
+  py::class_<PySchedule>(m, "Schedule")
+      .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"))
+      .def(py::init(&PySchedule::make<PackedBodies>), py::arg("bodies"), py::arg("contacts"))
+      .def_property_readonly("batches", [](const PySchedule& s) { return s.schedule.batch_count(); })
+      .def_property_readonly("largest_batch", [](const PySchedule& s) { return s.schedule.largest_batch(); })
+      .def_readonly("build_seconds", &PySchedule::build_seconds);
+
+  py::class_<PySolver>(m, "Solver")
+      .def(py::init<const std::string&, int, const py::object&, const std::string&>(), py::kw_only(),
+           py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(), py::arg("accuracy") = "fast")
+      .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
+      .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
+      .def_property_readonly("isa", [](const PySolver& s) { return to_string(s.solver->isa()); })
+      .def_property_readonly("accuracy", [](const PySolver& s) { return to_string(s.solver->options().accuracy); })
+      .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
+           py::arg("check") = true, py::arg("impacts") = true)
+      .def("solve", &PySolver::solve<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
+           py::arg("check") = true, py::arg("impacts") = true);
+
+  py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
+      .def_property_readonly("J", &Reference::j_array)
+      .def_property_readonly("v", [](const Reference& r) { return r.vec_array(false); })
+      .def_property_readonly("w", [](const Reference& r) { return r.vec_array(true); })
+      .def_property_readonly("impulse_scale", &Reference::impulse_scale)
+      .def_property_readonly("dtype", [](const Reference& r) { return numpy_dtype(r.dtype); })
+      .def("__len__", [](const Reference& r) { return r.impulses.size(); });
+
+  m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"));
+  m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
+  m.attr("accurate_error_ulps") = kAccurateErrorUlps;
+  m.attr("error_target_eps") = kImpulseErrorTargetEps;
+  m.attr("error_bound_eps") = kImpulseErrorBoundEps;
+
+  m.def(
+      "simd_width",
+      [](const std::string& isa, const py::object& dtype) {
+        const Dtype d = parse_dtype(dtype);
+        const Isa i = resolve_isa(parse_isa(isa));
+        return d == Dtype::f32 ? simd_width<float>(i) : simd_width<double>(i);
+      },
+      py::arg("isa") = "auto", py::arg("dtype"));
+  m.def(
+      "isa_supported", [](const std::string& isa) { return isa_supported(parse_isa(isa)); }, py::arg("isa"));
+  m.def("best_isa", [] { return std::string(to_string(best_isa())); });
+}
+
+}  // namespace collide::python
