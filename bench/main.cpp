@@ -846,19 +846,6 @@ class CollectingReporter : public benchmark::BenchmarkReporter {
   bool medians_ = false;
 };
 
-/// The 1-minute load average: other processes running skew every row.
-double load_average() {
-  std::FILE* f = std::fopen("/proc/loadavg", "r");
-  double load = -1;
-  if (f) {
-    if (std::fscanf(f, "%lf", &load) != 1) {
-      load = -1;
-    }
-    std::fclose(f);
-  }
-  return load;
-}
-
 struct Options {
   std::vector<std::size_t> sizes{10000, 65536, 262144, 1048576, 4194304, 16777216};
   bool quick = false;
