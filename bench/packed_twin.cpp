@@ -76,14 +76,13 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
       // The records are read as 16-byte rows into one accumulator per row
       // (every line of the record, as the kernel's row loads): short,
       // independent add chains of vector adds, so the loop waits on memory
-      // and not on arithmetic. (A scalar sum over the values made the twin
-      // slower than the kernel it is meant to bound.)
+      // and not on arithmetic, and a twin is a ceiling only if it is not
+      // slower than the kernel it bounds.
       //
       // Contacts go in groups of kGroup, as the kernel's lanes: every load
       // of a group (indices, fields, both records, the inverse masses) comes
-      // before its stores. Contact by contact, each store's address waited
-      // on an inverse-mass load and the next contact's loads queued behind
-      // it: that twin ran at half the kernel's speed, no ceiling.
+      // before its stores, so that no store's address, which waits on an
+      // inverse-mass load, holds the next contact's loads back.
       Row acc[kRows] = {};
       Record spare{};
       for (std::size_t p = begin; p < std::min(end, begin + 2 * kAhead); ++p) prefetch_contact(p);

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -39,6 +40,18 @@ double status_bytes(const char* field) {
     return kib * 1024.0;
   }
   return 0;
+}
+
+double load_average() {
+  std::FILE* f = std::fopen("/proc/loadavg", "r");
+  double load = -1;
+  if (f) {
+    if (std::fscanf(f, "%lf", &load) != 1) {
+      load = -1;
+    }
+    std::fclose(f);
+  }
+  return load;
 }
 
 bool reset_peak_rss() {

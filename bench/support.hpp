@@ -1,6 +1,7 @@
 // bench/support.hpp - what every benchmark of collide_bench shares: the
-// byte count of the law, the machine's cache and memory facts, the triad
-// bandwidth measured earlier in the same run, and the counter layout.
+// byte count of the law, the machine's cache, memory and load facts, the
+// triad bandwidth measured earlier in the same run, the timed loop and the
+// counter layout.
 //
 // Design notes
 // ------------
@@ -19,7 +20,19 @@
 //   machine, in the same process, a few seconds earlier.
 // * Every row of the table has the same counters (see Columns), so the
 //   tabular console output prints one header for the whole run; a column that
-//   does not apply to a row is 0.
+//   does not apply to a row is 0: coll/s = collisions per second (contacts
+//   scheduled per second on schedule rows, elements per second on triad
+//   rows); GB/s = coll/s x B/coll; bw_frac = GB/s / triad GB/s at the same
+//   thread count; B/coll = bytes of the law's inputs and outputs per
+//   collision; batches = schedule batches; sched_B/c =
+//   Schedule::memory_bytes() / contacts; peak_MiB = VmHWM.
+// * Rows time themselves (UseManualTime): steady_clock around the one timed
+//   call of an iteration, whatever untimed work precedes it. Reading the
+//   clock costs tens of nanoseconds against at least tens of microseconds for
+//   the smallest solve, and unlike PauseTiming/ResumeTiming it does not
+//   distort small N. The CPU column of Google Benchmark is the main thread's
+//   CPU time over the whole loop, untimed work included: read the Time column
+//   (the manual time).
 #pragma once
 
 #include <benchmark/benchmark.h>
@@ -54,6 +67,10 @@ std::size_t llc_bytes();
 /// A field of /proc/self/status ("VmRSS", "VmHWM") in bytes, or 0 if unknown.
 double status_bytes(const char* field);
 
+/// The 1-minute load average (/proc/loadavg), -1 if unknown: other processes
+/// running skew every row.
+double load_average();
+
 /// Resets the peak resident set size (VmHWM) to the current RSS by writing 5
 /// to /proc/self/clear_refs. Returns false where the kernel does not allow it.
 bool reset_peak_rss();
@@ -73,6 +90,26 @@ void set_triad_gbs(int threads, double gbs);
 
 /// Registers triad/t:1 and triad/t:2. Must come before every other row.
 void register_triad();
+
+/// The benchmark loop of a row: per iteration `untimed()` (nothing by
+/// default), then `timed()` with steady_clock around it alone, reported as
+/// the iteration's manual time. Returns the measured time of all iterations
+/// together.
+template <class Timed, class Untimed = void (*)()>
+double time_iterations(
+    benchmark::State& state, Timed&& timed, Untimed&& untimed = [] {}) {
+  double seconds = 0;
+  for (auto _ : state) {
+    untimed();
+    const auto t0 = Clock::now();
+    timed();
+    const auto t1 = Clock::now();
+    const double s = seconds_between(t0, t1);
+    state.SetIterationTime(s);
+    seconds += s;
+  }
+  return seconds;
+}
 
 /// The counters of every row (see the design notes above).
 struct Columns {

@@ -26,14 +26,7 @@ void triad_benchmark(benchmark::State& state, int threads) {
   // The library's triad (collide/eval/bandwidth.hpp), the one `collide report`
   // uses; here its passes are timed by the benchmark loop.
   collide::TriadArrays triad(threads, collide::default_triad_array_bytes());
-  double seconds = 0;
-  for (auto _ : state) {
-    const auto t0 = Clock::now();
-    triad.pass();
-    const auto t1 = Clock::now();
-    state.SetIterationTime(seconds_between(t0, t1));
-    seconds += seconds_between(t0, t1);
-  }
+  const double seconds = time_iterations(state, [&] { triad.pass(); });
 
   const double gbs = triad.bytes_per_pass() * static_cast<double>(state.iterations()) / seconds / 1e9;
   set_triad_gbs(threads, gbs);

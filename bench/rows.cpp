@@ -1,0 +1,290 @@
+// bench/rows.cpp - the bodies of collide_bench's rows: each takes its scene
+// from the cache (scenes.hpp), times its solve and writes the common
+// counters (support.hpp).
+//
+// Design notes
+// ------------
+// * Only the solve itself is timed. Before every timed solve the scene is
+//   reset untimed (Prepared::reset_for_solve: the pristine velocities back,
+//   and a cold cache for a scene larger than the LLC), so every solve starts
+//   from the same state.
+// * The Schedule is built once per scene (untimed, it is reusable) and a
+//   Solver once per row; for a scene that fits in the LLC one untimed solve
+//   before the loop starts the worker threads. Schedule::build has its own
+//   rows.
+// * Isa::automatic measures the ISAs at the first solve of each kind in a
+//   process; every row asks for that measurement before its timed loop, so
+//   that no row times the one-off cost.
+#include "rows.hpp"
+
+#include <oneapi/tbb/task_arena.h>
+
+#include <string>
+#include <type_traits>
+#include <utility>
+
+#include "collide/eval/traffic.hpp"
+#include "collide/packed.hpp"
+#include "collide/schedule.hpp"
+#include "memory_twin.hpp"
+#include "packed_twin.hpp"
+#include "support.hpp"
+#include "textbook.hpp"
+
+namespace collide_bench {
+namespace {
+
+using collide::Path;
+
+/// Times `solve_once` with the scene reset before each call (untimed), and
+/// `reset` after the scene's reset (untimed too).
+template <class T, class F, class R = void (*)()>
+double timed_solves(
+    benchmark::State& state, Prepared<T>& p, F&& solve_once, R&& reset = [] {}) {
+  // Warm-up, for a scene that fits in the LLC: worker threads started, code
+  // and data in cache. A larger scene starts cold anyway, and one more solve
+  // of it would cost seconds for a thread start-up of microseconds.
+  if (!p.exceeds_llc) {
+    p.reset_for_solve();
+    reset();
+    solve_once();
+  }
+  const double seconds = time_iterations(state, solve_once, [&] {
+    p.reset_for_solve();
+    reset();
+  });
+  p.restore();
+  return seconds;
+}
+
+/// Runs collide::fastest_isa's measurement for the model's solves, pairs and
+/// scattered, before a row's timed loop.
+template <class T>
+void measure_isa_auto(collide::Model model, collide::Accuracy accuracy = collide::Accuracy::fast) {
+  for (const bool scattered : {false, true}) (void)collide::fastest_isa<T>(model, accuracy, scattered);
+}
+
+/// The columns of a row that solves `n` contacts of `bytes_per_collision`
+/// bytes each on `threads` threads.
+Columns solve_columns(std::size_t n, std::size_t bytes_per_collision, double seconds, int threads) {
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.bytes_per_item = static_cast<double>(bytes_per_collision);
+  columns.seconds = seconds;
+  columns.threads = threads;
+  return columns;
+}
+
+/// "<model>, <layout>, <isa>, <lanes> lanes": what a model-dispatching solve
+/// ran.
+std::string model_label(const collide::SolveStats& stats) {
+  return std::string(collide::to_string(stats.model)) + ", " + collide::to_string(stats.layout) + ", " +
+         collide::to_string(stats.isa) + ", " + std::to_string(stats.lanes) + " lanes";
+}
+
+/// f(Record{}) with the packed record type of `model`: the one place the
+/// layout and twin rows turn a model into a record type.
+template <class T, class F>
+auto with_record(collide::Model model, F&& f) {
+  switch (model) {
+    case collide::Model::particle:
+      return f(collide::PackedParticle<T>{});
+    case collide::Model::sphere:
+      return f(collide::PackedSphere<T>{});
+    case collide::Model::rigid:
+      break;
+  }
+  return f(collide::PackedRigid<T>{});
+}
+
+/// The bench's rigid bodies packed into records of a model (they fit it:
+/// Prepared scenes are generated for the model).
+template <class T, class Record>
+void pack_as(const collide::BodyView<T>& bodies, const collide::PackedView<Record>& view) {
+  if constexpr (std::is_same_v<Record, collide::PackedRigid<T>>) {
+    collide::pack(bodies, view);
+  } else if constexpr (std::is_same_v<Record, collide::PackedSphere<T>>) {
+    collide::pack(collide::sphere_view(bodies), view);
+  } else {
+    collide::pack(collide::particle_view(bodies), view);
+  }
+}
+
+/// One model on one layout, the rigid view's arrays (SoA) or packed records.
+template <class T, class Record>
+double layout_solve(benchmark::State& state, Prepared<T>& p, const collide::Solver& solver, collide::Model model,
+                    LayoutRow layout, collide::SolveStats& stats) {
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  if (layout != LayoutRow::records) {
+    // One untimed solve sizes the solver's buffers (packing, ordered
+    // contacts): a frame loop pays that once, not per frame.
+    p.reset_for_solve();
+    solver.solve(model, bodies, contacts, impulses, p.schedule);
+    return timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
+  }
+  collide::PackedBuffer<Record> records(bodies.count);
+  const collide::PackedView<Record> view = collide::packed_view(records);
+  return timed_solves(
+      state, p, [&] { stats = solver.solve(view, contacts, impulses, p.schedule); }, [&] { pack_as(bodies, view); });
+}
+
+/// The packed twin's passes over records packed from the scene.
+template <class T, class Record>
+double packed_twin_solves(benchmark::State& state, Prepared<T>& p, int threads) {
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  collide::PackedBuffer<Record> records(p.bodies().count);
+  pack_as(p.bodies(), collide::packed_view(records));
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, p.schedule);  // sizes its buffers
+  return timed_solves(state, p,
+                      [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, p.schedule); });
+}
+
+}  // namespace
+
+template <class T>
+void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int threads, collide::Isa isa) {
+  Prepared<T>& p = prepared_scene<T>(kind, n);
+  measure_isa_auto<T>(collide::Model::rigid);
+  collide::SolverOptions options;
+  options.path = path;
+  options.threads = threads;
+  options.isa = isa;
+  const collide::Solver solver(options);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  collide::SolveStats stats;
+  const double seconds = timed_solves(state, p, [&] { stats = solver.solve(bodies, contacts, impulses, p.schedule); });
+
+  Columns columns = solve_columns(n, bytes_per_collision<T>(p.friction), seconds, threads);
+  columns.batches = static_cast<double>(stats.batches);
+  columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+  state.SetLabel(std::string(path == Path::simd ? collide::to_string(stats.isa) : "scalar") + ", " +
+                 std::to_string(stats.lanes) + " lanes");
+}
+
+// Through the Model-dispatching Solver::solve: the views of the smaller
+// models read only their own arrays, so the bytes per collision are the
+// model's own (collide/eval/traffic.hpp).
+template <class T>
+void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
+               collide::Accuracy accuracy) {
+  Prepared<T>& p = prepared_scene<T>(kind, n, model, friction);
+  measure_isa_auto<T>(model, accuracy);
+  collide::SolverOptions options;
+  options.path = Path::simd;
+  options.threads = threads;
+  options.accuracy = accuracy;
+  const collide::Solver solver(options);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  if (!collide::model_misfit(model, bodies, contacts).empty()) {
+    state.SkipWithError("the scene does not fit the model");
+    return;
+  }
+  collide::SolveStats stats;
+  const double seconds =
+      timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
+
+  Columns columns = solve_columns(n, collide::bytes_per_collision(model, sizeof(T), p.friction), seconds, threads);
+  columns.batches = static_cast<double>(stats.batches);
+  columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+  state.SetLabel(model_label(stats));
+}
+
+template <class T>
+void layout_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads,
+                LayoutRow layout) {
+  Prepared<T>& p = prepared_scene<T>(kind, n, model, friction);
+  measure_isa_auto<T>(model);
+  collide::SolverOptions options;
+  options.path = Path::simd;
+  options.threads = threads;
+  options.layout = layout == LayoutRow::soa ? collide::BodyLayout::soa : collide::BodyLayout::packed;
+  const collide::Solver solver(options);
+  collide::SolveStats stats;
+  const double seconds = with_record<T>(
+      model, [&](auto record) { return layout_solve<T, decltype(record)>(state, p, solver, model, layout, stats); });
+  Columns columns = solve_columns(n, collide::bytes_per_collision(model, sizeof(T), p.friction), seconds, threads);
+  columns.batches = static_cast<double>(stats.batches);
+  set_counters(state, columns);
+  state.SetLabel(model_label(stats));
+}
+
+// On the scene of the model rows: the ceiling of the model's data layout, in
+// the same bytes per collision.
+template <class T>
+void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, bool friction, int threads) {
+  Prepared<T>& p = prepared_scene<T>(kind, n, model, friction);
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  const double seconds = timed_solves(state, p, [&] { memory_twin_pass<T>(model, arena, bodies, contacts, impulses); });
+
+  set_counters(state, solve_columns(n, collide::bytes_per_collision(model, sizeof(T), p.friction), seconds, threads));
+  state.SetLabel("memory only");
+}
+
+// On the scene of the layout rows: the ceiling of the layout/.../records
+// rows.
+template <class T>
+void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, int threads) {
+  Prepared<T>& p = prepared_scene<T>(kind, n, model, false);
+  const double seconds =
+      with_record<T>(model, [&](auto record) { return packed_twin_solves<T, decltype(record)>(state, p, threads); });
+  set_counters(state, solve_columns(n, collide::bytes_per_collision(model, sizeof(T), false), seconds, threads));
+  state.SetLabel("memory only, packed");
+}
+
+template <class T>
+void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
+  Prepared<T>& p = prepared_scene<T>(kind, n);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  const double seconds = timed_solves(state, p, [&] { textbook_solve(bodies, contacts, impulses); });
+
+  set_counters(state, solve_columns(n, bytes_per_collision<T>(p.friction), seconds, 1));
+}
+
+template <class T>
+void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
+  Prepared<T>& p = prepared_scene<T>(kind, n);
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  // A schedule of its own, built once untimed: later builds reuse its buffers,
+  // as a simulation that rebuilds every frame does.
+  collide::Schedule schedule;
+  schedule.build(contacts, bodies);
+  const double seconds = time_iterations(state, [&] { schedule.build(contacts, bodies); });
+  Columns columns;
+  columns.items = static_cast<double>(n);
+  columns.seconds = seconds;
+  columns.batches = static_cast<double>(schedule.batch_count());
+  columns.schedule_bytes_per_contact = static_cast<double>(schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+}
+
+#define COLLIDE_BENCH_ROWS(T)                                                                                     \
+  template void solve_row<T>(benchmark::State&, Kind, std::size_t, Path, int, collide::Isa);                      \
+  template void model_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int, collide::Accuracy); \
+  template void layout_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int, LayoutRow);        \
+  template void twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int);                     \
+  template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
+  template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
+  template void schedule_row<T>(benchmark::State&, Kind, std::size_t);
+COLLIDE_BENCH_ROWS(float)
+COLLIDE_BENCH_ROWS(double)
+#undef COLLIDE_BENCH_ROWS
+
+}  // namespace collide_bench
