@@ -2,7 +2,8 @@
 //
 // Design notes
 // ------------
-// * Streaming: items (pairs, or debris bodies then debris contacts) are
+// * Streaming: items (pairs, or the bodies then the contacts of a debris or
+//   pile scene) are
 //   generated in blocks by a tbb pipeline: blocks are drawn and formatted in
 //   parallel and written in order, with a few blocks in memory at a time, so
 //   ten million pairs need tens of megabytes, not gigabytes. Every item is a
@@ -22,9 +23,11 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -43,9 +46,9 @@
 namespace collide::cli {
 
 const char* const kGenUsage =
-    "usage: collide gen (--pairs N | --debris N) --out DIR [--seed S] [--friction]\n"
-    "                   [--model rigid|sphere|particle] [--format csv|npz]\n"
-    "                   [--precision float|double] [--threads N]\n"
+    "usage: collide gen (--pairs N | --debris N | --pile S [--shuffle]) --out DIR\n"
+    "                   [--seed S] [--friction] [--model rigid|sphere|particle]\n"
+    "                   [--format csv|npz] [--precision float|double] [--threads N]\n"
     "\n"
     "Writes a random scene as DIR/bodies.csv and DIR/contacts.csv, or with\n"
     "--format npz as the binary DIR/bodies.npz and DIR/contacts.npz (DIR is created\n"
@@ -54,6 +57,12 @@ const char* const kGenUsage =
     "  --pairs N      N independent approaching pairs: contact k joins bodies 2k, 2k+1\n"
     "  --debris N     N contacts over N/2 movable bodies that share contacts, plus an\n"
     "                 immovable ground body (the last) on side b of every 4th contact\n"
+    "  --pile S       a pile of S x S x S boxes, S boxes per side (S = 100: 1000000\n"
+    "                 boxes and 2980000 contacts; at most 1625), each touching its\n"
+    "                 +x, +y and +z neighbours, the bottom layer on an immovable\n"
+    "                 ground body (the last): 3 S^2 (S - 1) + S^2 contacts, listed\n"
+    "                 cell by cell as a grid broadphase emits them\n"
+    "  --shuffle      the pile's contacts in a random order drawn from the seed\n"
     "  --out DIR      output directory\n"
     "  --seed S       64-bit seed (default 1)\n"
     "  --friction     draw mu uniformly from [0, 1) (default: mu = 0)\n"
@@ -161,17 +170,37 @@ void write_pairs(std::size_t pairs, const GenerateOptions& options, OutputFile& 
       });
 }
 
-void write_debris(std::size_t count, const GenerateOptions& options, OutputFile& bodies, OutputFile& contacts) {
-  const std::size_t body_count = debris_body_count(count);
+/// A scene drawn body by body and contact by contact (debris, pile): item
+/// i of each is a pure function of the options and i (generate.hpp).
+struct SharedBodyScene {
+  std::string name;  ///< for the progress line
+  std::size_t bodies = 0, contacts = 0;
+  std::function<void(std::uint64_t, BodyRecord<double>&)> draw_body;
+  std::function<void(std::uint64_t, ContactRecord<double>&)> draw_contact;
+};
+
+SharedBodyScene debris_scene(std::size_t count, const GenerateOptions& options) {
+  return {"debris", debris_body_count(count), count,
+          [count, options](std::uint64_t i, BodyRecord<double>& body) { draw_debris_body(options, count, i, body); },
+          [count, options](std::uint64_t k, ContactRecord<double>& c) { draw_debris_contact(options, count, k, c); }};
+}
+
+SharedBodyScene pile_scene(std::size_t side, const GenerateOptions& options) {
+  return {"pile", pile_body_count(side), pile_contact_count(side),
+          [side, options](std::uint64_t i, BodyRecord<double>& body) { draw_pile_body(options, side, i, body); },
+          [side, options](std::uint64_t k, ContactRecord<double>& c) { draw_pile_contact(options, side, k, c); }};
+}
+
+void write_shared(const SharedBodyScene& scene, OutputFile& bodies, OutputFile& contacts) {
   bodies.write(bodies_header());
   {
-    Progress progress("debris bodies", body_count);
+    Progress progress(scene.name + " bodies", scene.bodies);
     stream_blocks(
-        body_count, 8192,
+        scene.bodies, 8192,
         [&](std::size_t begin, std::size_t end, BlockText& text) {
           BodyRecord<double> body;
           for (std::size_t i = begin; i < end; ++i) {
-            draw_debris_body(options, count, i, body);
+            scene.draw_body(i, body);
             append_body_row(text.first, body);
           }
         },
@@ -181,13 +210,13 @@ void write_debris(std::size_t count, const GenerateOptions& options, OutputFile&
         });
   }
   contacts.write(contacts_header());
-  Progress progress("debris contacts", count);
+  Progress progress(scene.name + " contacts", scene.contacts);
   stream_blocks(
-      count, 8192,
+      scene.contacts, 8192,
       [&](std::size_t begin, std::size_t end, BlockText& text) {
         ContactRecord<double> c;
         for (std::size_t k = begin; k < end; ++k) {
-          draw_debris_contact(options, count, k, c);
+          scene.draw_contact(k, c);
           append_contact_row(text.first, c);
         }
       },
@@ -197,11 +226,13 @@ void write_debris(std::size_t count, const GenerateOptions& options, OutputFile&
       });
 }
 
-/// Draws the scene into columns of T and writes them as binary files.
+/// Draws the scene (pairs of `pairs` pairs, or else `shared`) into columns
+/// of T and writes them as binary files.
 template <class T>
-void write_npz_scene(bool pairs, std::size_t n, const GenerateOptions& options, OutputFile& bodies_out,
-                     OutputFile& contacts_out) {
-  const std::size_t body_count = pairs ? 2 * n : debris_body_count(n);
+void write_npz_scene(const SharedBodyScene* shared, std::size_t pairs, const GenerateOptions& options,
+                     OutputFile& bodies_out, OutputFile& contacts_out) {
+  const std::size_t body_count = shared ? shared->bodies : 2 * pairs;
+  const std::size_t n = shared ? shared->contacts : pairs;
   BodyTable<T> table;
   table.resize(body_count);
   std::vector<BodyIndex> a(n), b(n);
@@ -219,7 +250,7 @@ void write_npz_scene(bool pairs, std::size_t n, const GenerateOptions& options, 
     for (std::size_t j = 0; j < 8; ++j) real[j][k] = static_cast<T>(v[j]);
   };
   using Range = oneapi::tbb::blocked_range<std::size_t>;
-  if (pairs) {
+  if (!shared) {
     oneapi::tbb::parallel_for(Range(0, n, 8192), [&](const Range& r) {
       BodyRecord<double> ba, bb;
       ContactRecord<double> c;
@@ -234,14 +265,14 @@ void write_npz_scene(bool pairs, std::size_t n, const GenerateOptions& options, 
     oneapi::tbb::parallel_for(Range(0, body_count, 8192), [&](const Range& r) {
       BodyRecord<double> body;
       for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        draw_debris_body(options, n, i, body);
+        shared->draw_body(i, body);
         put_body(i, body);
       }
     });
     oneapi::tbb::parallel_for(Range(0, n, 8192), [&](const Range& r) {
       ContactRecord<double> c;
       for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        draw_debris_contact(options, n, k, c);
+        shared->draw_contact(k, c);
         put_contact(k, c);
       }
     });
@@ -264,6 +295,8 @@ int run_gen(int argc, char** argv) {
   const Options opt = parse_options(argc, argv, 2,
                                     {{"pairs", true},
                                      {"debris", true},
+                                     {"pile", true},
+                                     {"shuffle", false},
                                      {"out", true},
                                      {"seed", true},
                                      {"threads", true},
@@ -277,15 +310,28 @@ int run_gen(int argc, char** argv) {
   }
   const bool pairs = opt.count("pairs") != 0;
   const bool debris = opt.count("debris") != 0;
-  if (pairs == debris) throw UsageError("give exactly one of --pairs N and --debris N");
-  const unsigned long long n = pairs ? parse_count("pairs", opt.at("pairs")) : parse_count("debris", opt.at("debris"));
-  // Body ids are 32-bit (contacts.hpp): 2N bodies for pairs, N/2 + 1 for debris.
+  const bool pile = opt.count("pile") != 0;
+  if (static_cast<int>(pairs) + static_cast<int>(debris) + static_cast<int>(pile) != 1) {
+    throw UsageError("give exactly one of --pairs N, --debris N and --pile S");
+  }
+  const char* const kind = pairs ? "pairs" : debris ? "debris" : "pile";
+  const unsigned long long n = parse_count(kind, opt.at(kind));
+  // Body ids are 32-bit (contacts.hpp): 2N bodies for pairs, N/2 + 1 for
+  // debris, S^3 + 1 for a pile.
+  if (pile && n > kMaxPileSide) {
+    throw UsageError("--pile " + opt.at("pile") + " is too large: at most " + std::to_string(kMaxPileSide) +
+                     " boxes per side (body ids are 32-bit)");
+  }
   const unsigned long long max_n = pairs ? 0x7FFFFFFFULL : 0xFFFFFFFFULL;
   if (n > max_n) throw UsageError("scene too large: body ids are 32-bit");
+  if (opt.count("shuffle") != 0 && !pile) {
+    throw UsageError("--shuffle is for --pile (the pairs and debris contacts have no spatial order to shuffle)");
+  }
   const std::string& dir = required(opt, "out");
   GenerateOptions options;
   if (const auto it = opt.find("seed"); it != opt.end()) options.seed = parse_count("seed", it->second);
   options.friction = opt.count("friction") != 0;
+  options.shuffle = opt.count("shuffle") != 0;
   if (const auto it = opt.find("model"); it != opt.end()) {
     const std::string& m = it->second;
     if (m != "rigid" && m != "sphere" && m != "particle") {
@@ -318,16 +364,21 @@ int run_gen(int argc, char** argv) {
   const std::string suffix = format == SceneFormat::npz ? ".npz" : ".csv";
   OutputFile bodies(dir + "/bodies" + suffix);
   OutputFile contacts(dir + "/contacts" + suffix);
+  const auto count = static_cast<std::size_t>(n);
+  std::optional<SharedBodyScene> shared;
+  if (debris) shared = debris_scene(count, options);
+  if (pile) shared = pile_scene(count, options);
+  const SharedBodyScene* const scene = shared ? &*shared : nullptr;
   if (format == SceneFormat::npz) {
     if (want_float) {
-      write_npz_scene<float>(pairs, static_cast<std::size_t>(n), options, bodies, contacts);
+      write_npz_scene<float>(scene, count, options, bodies, contacts);
     } else {
-      write_npz_scene<double>(pairs, static_cast<std::size_t>(n), options, bodies, contacts);
+      write_npz_scene<double>(scene, count, options, bodies, contacts);
     }
-  } else if (pairs) {
-    write_pairs(static_cast<std::size_t>(n), options, bodies, contacts);
+  } else if (scene) {
+    write_shared(*scene, bodies, contacts);
   } else {
-    write_debris(static_cast<std::size_t>(n), options, bodies, contacts);
+    write_pairs(count, options, bodies, contacts);
   }
   bodies.commit();
   contacts.commit();

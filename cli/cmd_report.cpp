@@ -17,11 +17,12 @@
 namespace collide::cli {
 
 const char* const kReportUsage =
-    "usage: collide report [--n N] [--debris-n N] [--threads LIST] [--json FILE]\n"
-    "                      [--plot FILE.png] [--sample N] [--runs R] [--seed S] [--quick]\n"
-    "                      [--hard] [--hard-n N] [--bodies B --contacts C]\n"
+    "usage: collide report [--n N] [--debris-n N] [--pile-n N] [--threads LIST]\n"
+    "                      [--json FILE] [--plot FILE.png] [--sample N] [--runs R]\n"
+    "                      [--seed S] [--quick] [--hard] [--hard-n N]\n"
+    "                      [--bodies B --contacts C]\n"
     "\n"
-    "Measures every variant of the solver on the pairs scene and the debris scene:\n"
+    "Measures every variant of the solver on the pairs, debris and pile scenes:\n"
     "speed (collisions per second, median of R timed runs, and the fraction of the\n"
     "memory-bandwidth bound) and error against the long double reference (impulse\n"
     "error in eps times the contact's impulse scale, relative error, momentum and\n"
@@ -31,6 +32,10 @@ const char* const kReportUsage =
     "  --debris-n N    collisions of the debris scene (default: N, at most 1000000;\n"
     "                  its random body accesses run 3 to 10 times slower per\n"
     "                  collision, so this keeps the default run to a few minutes)\n"
+    "  --pile-n N      collisions of the pile scene, boxes on a lattice touching their\n"
+    "                  neighbours and the ground (as collide gen --pile): the largest\n"
+    "                  cubic pile with at most N contacts (default: N, at most\n"
+    "                  1000000, which gives 69^3 boxes and 976005 contacts)\n"
     "  --threads LIST  comma-separated thread counts of the kernel rows (default 1,2)\n"
     "  --json FILE     also write every row as JSON\n"
     "  --plot FILE     also write a PNG with gnuplot: throughput against error, and\n"
@@ -87,6 +92,7 @@ int run_report(int argc, char** argv) {
   const Options opt = parse_options(argc, argv, 2,
                                     {{"n", true},
                                      {"debris-n", true},
+                                     {"pile-n", true},
                                      {"threads", true},
                                      {"json", true},
                                      {"plot", true},
@@ -128,6 +134,12 @@ int run_report(int argc, char** argv) {
       throw UsageError("--debris-n must be from 1 to 2^32 - 1");
   } else {
     config.debris_n = std::min(config.n, config.debris_n);
+  }
+  if (const auto it = opt.find("pile-n"); it != opt.end()) {
+    config.pile_n = parse_count("pile-n", it->second);
+    if (config.pile_n < 1 || config.pile_n > 0xFFFFFFFFULL) throw UsageError("--pile-n must be from 1 to 2^32 - 1");
+  } else {
+    config.pile_n = std::min(config.n, config.pile_n);
   }
   config.hard = opt.count("hard") != 0 || opt.count("hard-n") != 0;
   if (const auto it = opt.find("hard-n"); it != opt.end()) {

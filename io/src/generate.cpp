@@ -1,4 +1,4 @@
-// generate.cpp - the random "pairs" and "debris" scenes.
+// generate.cpp - the random "pairs", "debris" and "pile" scenes.
 //
 // Design notes
 // ------------
@@ -19,12 +19,23 @@
 //   without friction share every other value.
 // * Only sin, cos and sqrt of libm are used; a scene is reproducible on the
 //   same platform (libm's sin/cos are not guaranteed identical elsewhere).
+// * The pile cannot re-draw a contact until it approaches: its boxes are
+//   shared by up to seven contacts. It approaches by construction instead: a
+//   compression field closes every lattice neighbour pair at 1 m/s, and the
+//   random parts of the velocities are bounded so that they take at most
+//   0.6 m/s of it (generate.hpp; the test checks every contact). Its
+//   contacts are drawn by cell-order index q, so that the shuffle, a
+//   permutation of the indices (a Feistel network keyed by the seed,
+//   cycle-walked into [0, count)), moves contacts without changing them and
+//   contact k is still a pure function of (seed, side, k).
 #include "collide/io/generate.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
@@ -38,6 +49,9 @@ constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
 constexpr std::uint64_t kPairStream = 0x7061697273000001ULL;
 constexpr std::uint64_t kDebrisBodyStream = 0x6465627269730002ULL;
 constexpr std::uint64_t kDebrisContactStream = 0x6465627269730003ULL;
+constexpr std::uint64_t kPileBodyStream = 0x70696c6500000004ULL;
+constexpr std::uint64_t kPileContactStream = 0x70696c6500000005ULL;
+constexpr std::uint64_t kPileShuffleStream = 0x70696c6500000006ULL;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinApproachSpeed = 1e-2;  // [m/s]
@@ -96,24 +110,28 @@ Vec3 unit_vec(CounterRng& rng) {
   return {s * std::cos(phi), s * std::sin(phi), z};
 }
 
+/// The unit quaternion (w, x, y, z) of a rotation vector (angle = |rv|).
+void store_rotation(Vec3 rv, double* q) {
+  const double angle = std::sqrt(dot(rv, rv));
+  if (angle > 1e-12) {
+    const double s = std::sin(0.5 * angle) / angle;
+    q[0] = std::cos(0.5 * angle);
+    q[1] = rv.x * s;
+    q[2] = rv.y * s;
+    q[3] = rv.z * s;
+  } else {
+    q[0] = 1.0;
+    q[1] = q[2] = q[3] = 0.0;
+  }
+}
+
 /// A random movable body: the page's draws, in sane positive ranges.
 /// `half_extent` is the half size of the box the centre lies in.
 void draw_movable_body(CounterRng& rng, double half_extent, BodyRecord<double>& body) {
   body.m = rng.uniform(0.1, 20.0);
   for (double& i : body.I) i = rng.uniform(0.1, 20.0);
   // Orientation from a rotation vector, angle = |vector|, as the page does.
-  const Vec3 rv = uniform_vec(rng, -kPi, kPi);
-  const double angle = std::sqrt(dot(rv, rv));
-  if (angle > 1e-12) {
-    const double s = std::sin(0.5 * angle) / angle;
-    body.q[0] = std::cos(0.5 * angle);
-    body.q[1] = rv.x * s;
-    body.q[2] = rv.y * s;
-    body.q[3] = rv.z * s;
-  } else {
-    body.q[0] = 1.0;
-    body.q[1] = body.q[2] = body.q[3] = 0.0;
-  }
+  store_rotation(uniform_vec(rng, -kPi, kPi), body.q);
   store(uniform_vec(rng, -half_extent, half_extent), body.p);
   store(uniform_vec(rng, -10.0, 10.0), body.v);
   store(uniform_vec(rng, -10.0, 10.0), body.w);
@@ -147,6 +165,191 @@ std::size_t debris_movable_count(std::size_t contacts) {
 /// Half size of the debris box: about one body per 8 m^3.
 double debris_half_extent(std::size_t movable) {
   return std::cbrt(static_cast<double>(std::max<std::size_t>(movable, 1)));
+}
+
+/// The immovable ground: infinite mass and moments, at rest at p.
+void store_ground(Vec3 p, BodyRecord<double>& body) {
+  const double inf = std::numeric_limits<double>::infinity();
+  body = BodyRecord<double>{};
+  body.m = inf;
+  body.I[0] = body.I[1] = body.I[2] = inf;
+  store(p, body.p);
+}
+
+// -- the pile ----------------------------------------------------------------
+
+// Geometry and velocities of the pile (generate.hpp). The approach margin:
+// a lattice neighbour pair closes at kPileCompression x 1 m = 1 m/s; the
+// random linear parts change that by at most 2 kPileVelocityJitter and the
+// spins by at most 2 x 2 kPileSpin kPileContactOffset (w . (r x n), where
+// r x n holds the two face offsets), 0.6 m/s in all; the bottom layer falls
+// onto the ground at 1 m/s, less 0.1 + 0.2. So every contact approaches by
+// at least 0.4 m/s, far above float's rounding of speeds below 2000 m/s.
+constexpr double kPileCompression = 1.0;     // [1/s]
+constexpr double kPileVelocityJitter = 0.1;  // [m/s] per axis
+constexpr double kPileSpin = 0.25;           // [rad/s] per axis
+constexpr double kPileContactOffset = 0.4;   // [m] per face axis, within every face (edges >= 0.9 m)
+constexpr double kPileMinEdge = 0.9;         // [m]
+constexpr double kPileMaxEdge = 1.0;         // [m]
+constexpr double kPileTilt = 0.05;           // [rad] per axis of the rotation vector
+
+/// Where the pile is compressed towards, and the ground's centre: under the
+/// middle of the pile, half a pitch below the ground plane z = 0.
+Vec3 pile_centre(std::size_t side) { return {0.5 * static_cast<double>(side), 0.5 * static_cast<double>(side), -0.5}; }
+
+/// The lattice point of box i: its centre.
+Vec3 pile_box_centre(std::size_t side, std::uint64_t i) {
+  const std::uint64_t ix = i % side;
+  const std::uint64_t iy = (i / side) % side;
+  const std::uint64_t iz = i / side / side;
+  return {static_cast<double>(ix) + 0.5, static_cast<double>(iy) + 0.5, static_cast<double>(iz) + 0.5};
+}
+
+/// Which body a pile contact joins to its box (side a).
+enum class PileNeighbour { x, y, z, ground };
+
+/// Contacts of one z layer: its +x and +y contacts, +z below the top layer,
+/// and the ground under the bottom one.
+std::uint64_t pile_layer_contacts(std::uint64_t side, bool up, bool ground) {
+  return 2 * side * (side - 1) + (static_cast<std::uint64_t>(up) + static_cast<std::uint64_t>(ground)) * side * side;
+}
+
+/// Contact q of the pile in cell order: its box and the neighbour, found by
+/// counting the contacts of whole layers, rows and cells before it (a cell's
+/// contacts are +x, +y, +z, ground, each where it exists).
+void locate_pile_contact(std::uint64_t side, std::uint64_t q, std::uint64_t& box, PileNeighbour& neighbour) {
+  const std::uint64_t s = side;
+  std::uint64_t iz = 0, r = q;
+  bool up = s > 1, ground = true;
+  if (const std::uint64_t bottom = pile_layer_contacts(s, up, true); r >= bottom) {
+    r -= bottom;
+    ground = false;
+    const std::uint64_t middle_layers = s >= 3 ? s - 2 : 0;
+    const std::uint64_t middle = pile_layer_contacts(s, true, false);
+    if (r < middle_layers * middle) {
+      iz = 1 + r / middle;
+      r %= middle;
+    } else {
+      iz = s - 1;
+      r -= middle_layers * middle;
+      up = false;
+    }
+  }
+  const std::uint64_t zg = static_cast<std::uint64_t>(up) + static_cast<std::uint64_t>(ground);
+  // A row below the last has s (2 + zg) - 1 contacts (its last cell has no +x).
+  const std::uint64_t row = s * (2 + zg) - 1;
+  std::uint64_t iy = 0;
+  bool has_y = true;
+  if (r < (s - 1) * row) {
+    iy = r / row;
+    r %= row;
+  } else {
+    iy = s - 1;
+    r -= (s - 1) * row;
+    has_y = false;
+  }
+  const std::uint64_t per_cell = 1 + static_cast<std::uint64_t>(has_y) + zg;
+  const std::uint64_t ix = r / per_cell;
+  std::uint64_t slot = r % per_cell;
+  PileNeighbour kinds[4];
+  std::uint64_t count = 0;
+  if (ix + 1 < s) kinds[count++] = PileNeighbour::x;
+  if (has_y) kinds[count++] = PileNeighbour::y;
+  if (up) kinds[count++] = PileNeighbour::z;
+  if (ground) kinds[count++] = PileNeighbour::ground;
+  slot = std::min(slot, count - 1);  // unreachable for q < pile_contact_count(side)
+  box = ix + s * (iy + s * iz);
+  neighbour = kinds[slot];
+}
+
+/// Contact q of the pile in cell order.
+void draw_pile_contact_at(const GenerateOptions& options, std::size_t side, std::uint64_t q,
+                          ContactRecord<double>& contact) {
+  std::uint64_t box = 0;
+  PileNeighbour neighbour = PileNeighbour::x;
+  locate_pile_contact(side, q, box, neighbour);
+  CounterRng rng(options.seed, kPileContactStream, q);
+  // Offsets within the touching face, along its two axes.
+  const double t1 = rng.uniform(-kPileContactOffset, kPileContactOffset);
+  const double t2 = rng.uniform(-kPileContactOffset, kPileContactOffset);
+  const Vec3 p = pile_box_centre(side, box);
+  const std::uint64_t s = side;
+  contact.a = static_cast<BodyIndex>(box);
+  Vec3 c{}, n{};
+  switch (neighbour) {
+    case PileNeighbour::x:
+      contact.b = static_cast<BodyIndex>(box + 1);
+      c = {p.x + 0.5, p.y + t1, p.z + t2};
+      n = {-1.0, 0.0, 0.0};
+      break;
+    case PileNeighbour::y:
+      contact.b = static_cast<BodyIndex>(box + s);
+      c = {p.x + t1, p.y + 0.5, p.z + t2};
+      n = {0.0, -1.0, 0.0};
+      break;
+    case PileNeighbour::z:
+      contact.b = static_cast<BodyIndex>(box + s * s);
+      c = {p.x + t1, p.y + t2, p.z + 0.5};
+      n = {0.0, 0.0, -1.0};
+      break;
+    case PileNeighbour::ground:
+      contact.b = static_cast<BodyIndex>(s * s * s);
+      c = {p.x + t1, p.y + t2, p.z - 0.5};
+      n = {0.0, 0.0, 1.0};
+      break;
+  }
+  store(c, contact.c);
+  store(n, contact.n);
+  contact.e = rng.uniform();
+  const double mu = rng.uniform();
+  contact.mu = options.friction ? mu : 0.0;
+}
+
+/// A bijection of [0, count) drawn from the seed: a Feistel network on the
+/// smallest even number of bits that holds count (a bijection of [0, 4^h)),
+/// cycle-walked: an image outside [0, count) is mapped again until it lands
+/// inside, which keeps it a bijection of [0, count) and takes fewer than 4
+/// steps on average since 4^h < 4 count.
+class IndexPermutation {
+ public:
+  IndexPermutation(std::uint64_t seed, std::uint64_t count) : count_(count) {
+    while (half_bits_ < 32 && (std::uint64_t{1} << (2 * half_bits_)) < count) ++half_bits_;
+    mask_ = (std::uint64_t{1} << half_bits_) - 1;
+    for (int round = 0; round < kRounds; ++round) {
+      keys_[round] =
+          splitmix64(splitmix64(seed ^ kPileShuffleStream) + count * kGolden + static_cast<std::uint64_t>(round));
+    }
+  }
+  std::uint64_t operator()(std::uint64_t i) const {
+    std::uint64_t x = i;
+    do {
+      x = feistel(x);
+    } while (x >= count_);
+    return x;
+  }
+
+ private:
+  static constexpr int kRounds = 6;
+  std::uint64_t feistel(std::uint64_t x) const {
+    std::uint64_t left = x >> half_bits_, right = x & mask_;
+    for (const std::uint64_t key : keys_) {
+      const std::uint64_t next = left ^ (splitmix64(key ^ right) & mask_);
+      left = right;
+      right = next;
+    }
+    return (left << half_bits_) | right;
+  }
+  std::uint64_t count_;
+  unsigned half_bits_ = 1;
+  std::uint64_t mask_ = 1;
+  std::uint64_t keys_[kRounds] = {};
+};
+
+void check_pile_side(std::size_t side) {
+  if (side > kMaxPileSide) {
+    throw std::invalid_argument("generate_pile: " + std::to_string(side) + " boxes per side, at most " +
+                                std::to_string(kMaxPileSide) + " (body ids are 32-bit)");
+  }
 }
 
 using detail::narrow;
@@ -187,11 +390,7 @@ void draw_debris_body(const GenerateOptions& options, std::size_t contacts, std:
   const double half = debris_half_extent(movable);
   if (i >= movable) {
     // The ground: immovable, at rest, just below the debris box.
-    const double inf = std::numeric_limits<double>::infinity();
-    body = BodyRecord<double>{};
-    body.m = inf;
-    body.I[0] = body.I[1] = body.I[2] = inf;
-    body.p[1] = -half - 1.0;
+    store_ground({0.0, -half - 1.0, 0.0}, body);
     return;
   }
   CounterRng rng(options.seed, kDebrisBodyStream, i);
@@ -230,6 +429,46 @@ void draw_debris_contact(const GenerateOptions& options, std::size_t contacts, s
   contact.e = rng.uniform();
   const double mu = rng.uniform();
   contact.mu = options.friction ? mu : 0.0;
+}
+
+std::size_t pile_body_count(std::size_t side) { return side * side * side + 1; }
+
+std::size_t pile_contact_count(std::size_t side) { return side == 0 ? 0 : 3 * side * side * (side - 1) + side * side; }
+
+std::size_t pile_side_for_contacts(std::size_t contacts) {
+  std::size_t side = 0;
+  while (side < kMaxPileSide && pile_contact_count(side + 1) <= contacts) ++side;
+  return side;
+}
+
+void draw_pile_body(const GenerateOptions& options, std::size_t side, std::uint64_t i, BodyRecord<double>& body) {
+  if (i >= static_cast<std::uint64_t>(side) * side * side) {
+    store_ground(pile_centre(side), body);
+    return;
+  }
+  CounterRng rng(options.seed, kPileBodyStream, i);
+  body.m = rng.uniform(0.1, 20.0);
+  const Vec3 edge = uniform_vec(rng, kPileMinEdge, kPileMaxEdge);
+  // A solid box's principal moments about its centre, along its edges.
+  body.I[0] = body.m * (edge.y * edge.y + edge.z * edge.z) / 12.0;
+  body.I[1] = body.m * (edge.x * edge.x + edge.z * edge.z) / 12.0;
+  body.I[2] = body.m * (edge.x * edge.x + edge.y * edge.y) / 12.0;
+  store_rotation(uniform_vec(rng, -kPileTilt, kPileTilt), body.q);
+  const Vec3 p = pile_box_centre(side, i);
+  store(p, body.p);
+  const Vec3 centre = pile_centre(side);
+  const Vec3 jitter = uniform_vec(rng, -kPileVelocityJitter, kPileVelocityJitter);
+  const Vec3 v{-kPileCompression * (p.x - centre.x) + jitter.x, -kPileCompression * (p.y - centre.y) + jitter.y,
+               -kPileCompression * (p.z - centre.z) + jitter.z};
+  store(v, body.v);
+  store(uniform_vec(rng, -kPileSpin, kPileSpin), body.w);
+  fit_model(options.model, body);
+}
+
+void draw_pile_contact(const GenerateOptions& options, std::size_t side, std::uint64_t k,
+                       ContactRecord<double>& contact) {
+  const std::uint64_t q = options.shuffle ? IndexPermutation(options.seed, pile_contact_count(side))(k) : k;
+  draw_pile_contact_at(options, side, q, contact);
 }
 
 template <class T>
@@ -277,9 +516,40 @@ Scene<T> generate_debris(std::size_t contacts, const GenerateOptions& options) {
   return scene;
 }
 
+template <class T>
+Scene<T> generate_pile(std::size_t side, const GenerateOptions& options) {
+  check_pile_side(side);
+  Scene<T> scene;
+  const std::size_t bodies = pile_body_count(side);
+  const std::size_t contacts = pile_contact_count(side);
+  scene.bodies.resize(bodies);
+  scene.contacts.resize(contacts);
+  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies, 4096),
+                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                              BodyRecord<double> body;
+                              for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                                draw_pile_body(options, side, i, body);
+                                scene.bodies.set(i, narrow<T>(body));
+                              }
+                            });
+  // The permutation once for the scene rather than once per contact.
+  const IndexPermutation shuffle(options.seed, contacts);
+  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, contacts, 4096),
+                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                              ContactRecord<double> c;
+                              for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                                draw_pile_contact_at(options, side, options.shuffle ? shuffle(k) : k, c);
+                                scene.contacts.set(k, narrow<T>(c));
+                              }
+                            });
+  return scene;
+}
+
 template Scene<float> generate_pairs<float>(std::size_t, const GenerateOptions&);
 template Scene<double> generate_pairs<double>(std::size_t, const GenerateOptions&);
 template Scene<float> generate_debris<float>(std::size_t, const GenerateOptions&);
 template Scene<double> generate_debris<double>(std::size_t, const GenerateOptions&);
+template Scene<float> generate_pile<float>(std::size_t, const GenerateOptions&);
+template Scene<double> generate_pile<double>(std::size_t, const GenerateOptions&);
 
 }  // namespace collide

@@ -196,12 +196,12 @@ def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
     return _collide.from_physical(arr(m, 0), arr(inertia, 3), arr(q, 4), arr(p, 3), arr(v, 3), arr(w, 3), dt)
 
 
-def report(*, n=4_000_000, debris_n=None, threads=(1, 2), sample=100_000, runs=5, seed=1, quick=False):
+def report(*, n=4_000_000, debris_n=None, pile_n=None, threads=(1, 2), sample=100_000, runs=5, seed=1, quick=False):
     """The rows of ``collide report`` as a list of dicts (speed and error of
-    every variant on the pairs and debris scenes; docs/report.md has the
+    every variant on the pairs, debris and pile scenes; docs/report.md has the
     columns). Takes minutes with the defaults; ``quick=True`` for a smoke run."""
-    return _collide.report(n=n, debris_n=debris_n, threads=list(threads), sample=sample, runs=runs, seed=seed,
-                           quick=quick)
+    return _collide.report(n=n, debris_n=debris_n, pile_n=pile_n, threads=list(threads), sample=sample, runs=runs,
+                           seed=seed, quick=quick)
 
 
 def report_hard(*, n=1000, runs=5):

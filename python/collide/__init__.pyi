@@ -207,6 +207,7 @@ def report(
     *,
     n: int = 4000000,
     debris_n: int | None = None,
+    pile_n: int | None = None,
     threads: Sequence[int] = (1, 2),
     sample: int = 100000,
     runs: int = 5,

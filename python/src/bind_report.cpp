@@ -31,11 +31,12 @@ auto measure_without_gil(F&& f) {
   return f();
 }
 
-py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::vector<int> threads, std::size_t sample,
-                   int runs, std::uint64_t seed, bool quick) {
+py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::optional<std::size_t> pile_n,
+                   std::vector<int> threads, std::size_t sample, int runs, std::uint64_t seed, bool quick) {
   ReportOptions o;
   o.n = n;
   o.debris_n = debris_n ? *debris_n : std::min<std::size_t>(n, o.debris_n);
+  o.pile_n = pile_n ? *pile_n : std::min<std::size_t>(n, o.pile_n);
   o.threads = std::move(threads);
   o.sample = sample;
   o.runs = runs;
@@ -111,8 +112,8 @@ py::list report_hard_py(std::size_t n, int runs) {
 
 void register_report(py::module_& m) {
   m.def("report", &report_py, py::kw_only(), py::arg("n") = 4000000, py::arg("debris_n") = py::none(),
-        py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000, py::arg("runs") = 5,
-        py::arg("seed") = 1, py::arg("quick") = false);
+        py::arg("pile_n") = py::none(), py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000,
+        py::arg("runs") = 5, py::arg("seed") = 1, py::arg("quick") = false);
   m.def("report_hard", &report_hard_py, py::kw_only(), py::arg("n") = 1000, py::arg("runs") = 5);
 }
 

@@ -5,7 +5,8 @@
 //   * every bad input of the spec: exit 1, a message naming the file, the row
 //     and the column, and no output file (a pre-existing one untouched);
 //   * gen: same seed, same bytes (whatever the thread count); other seed,
-//     other bytes;
+//     other bytes; the pile is the library's pile, its shuffle a permutation
+//     of its contact rows;
 //   * gen + solve --check round trips, both precisions and both paths;
 //   * the written numbers read back to the values the library computes;
 //   * inf of immovable bodies and all unchanged columns survive a solve;
@@ -26,6 +27,7 @@
 
 #include <gtest/gtest.h>
 
+#include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/io/scene_io.hpp"
 #include "collide/schedule.hpp"
@@ -598,10 +600,11 @@ TEST_F(CliTest, ForcedParticleRefusedWhereTheRotationMatters) {
 // ---------------------------------------------------------------------------
 
 TEST_F(CliTest, GenSameSeedSameBytesDifferentSeedDifferentBytes) {
-  for (const char* kind : {"--pairs", "--debris"}) {
-    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("a").string(), "--seed", "7", "--threads", "1"}).exit_code, 0);
-    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("b").string(), "--seed", "7"}).exit_code, 0);
-    ASSERT_EQ(run({"gen", kind, "20000", "--out", path("c").string(), "--seed", "8"}).exit_code, 0);
+  for (const auto& [kind, n] : std::vector<std::pair<std::string, std::string>>{
+           {"--pairs", "20000"}, {"--debris", "20000"}, {"--pile", "20"}}) {
+    ASSERT_EQ(run({"gen", kind, n, "--out", path("a").string(), "--seed", "7", "--threads", "1"}).exit_code, 0);
+    ASSERT_EQ(run({"gen", kind, n, "--out", path("b").string(), "--seed", "7"}).exit_code, 0);
+    ASSERT_EQ(run({"gen", kind, n, "--out", path("c").string(), "--seed", "8"}).exit_code, 0);
     for (const char* f : {"bodies.csv", "contacts.csv"}) {
       const std::string a = slurp(path("a") / f);
       EXPECT_EQ(a, slurp(path("b") / f)) << kind << " " << f;
@@ -650,9 +653,116 @@ TEST_F(CliTest, GenDebrisHasGroundLast) {
   EXPECT_NE(slurp(path("bodies.csv")).find("\ninf,inf,inf,inf,1,0,0,0,"), std::string::npos);
 }
 
+/// The lines of a text after its first (the header), sorted.
+std::vector<std::string> sorted_rows(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> rows;
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) rows.push_back(line);
+  std::sort(rows.begin(), rows.end());
+  return rows;
+}
+
+TEST_F(CliTest, GenPileWritesTheLibrarysPile) {
+  // --pile S: S boxes per side, the values of generate.hpp's pile exactly
+  // (the shortest text of each double reads back to it).
+  const std::size_t side = 6;
+  const RunResult r = run({"gen", "--pile", "6", "--out", dir_.string(), "--seed", "4", "--friction"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto table = collide::read_bodies<double>(path("bodies.csv").string());
+  ASSERT_EQ(table.size(), collide::pile_body_count(side));
+  ASSERT_EQ(table.size(), 217U);
+  const auto contacts = collide::read_contacts<double>(path("contacts.csv").string(), table.size());
+  ASSERT_EQ(contacts.size(), collide::pile_contact_count(side));
+  ASSERT_EQ(contacts.size(), 576U);  // 3 * 36 * 5 + 36
+  collide::GenerateOptions options;
+  options.seed = 4;
+  options.friction = true;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    collide::BodyRecord<double> body;
+    collide::draw_pile_body(options, side, i, body);
+    const double expected[17] = {body.m,    body.I[0], body.I[1], body.I[2], body.q[0], body.q[1],
+                                 body.q[2], body.q[3], body.p[0], body.p[1], body.p[2], body.v[0],
+                                 body.v[1], body.v[2], body.w[0], body.w[1], body.w[2]};
+    for (std::size_t k = 0; k < 17; ++k) ASSERT_EQ(table.column[k][i], expected[k]) << "body " << i << " column " << k;
+  }
+  EXPECT_TRUE(std::isinf(table.column[0][216])) << "the ground is last and immovable";
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    collide::ContactRecord<double> c;
+    collide::draw_pile_contact(options, side, k, c);
+    const auto got = contacts.record(k);
+    ASSERT_EQ(got.a, c.a) << k;
+    ASSERT_EQ(got.b, c.b) << k;
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_EQ(got.c[j], c.c[j]) << k;
+      ASSERT_EQ(got.n[j], c.n[j]) << k;
+    }
+    ASSERT_EQ(got.e, c.e) << k;
+    ASSERT_EQ(got.mu, c.mu) << k;
+  }
+  // Cell order: the first cell's +x, +y, +z neighbours, then the ground.
+  EXPECT_EQ(contacts.record(0).b, 1U);
+  EXPECT_EQ(contacts.record(1).b, 6U);
+  EXPECT_EQ(contacts.record(2).b, 36U);
+  EXPECT_EQ(contacts.record(3).b, 216U);
+}
+
+TEST_F(CliTest, GenPileShuffleIsAPermutationOfTheRows) {
+  ASSERT_EQ(run({"gen", "--pile", "9", "--out", path("o").string(), "--seed", "3"}).exit_code, 0);
+  ASSERT_EQ(
+      run({"gen", "--pile", "9", "--out", path("s").string(), "--seed", "3", "--shuffle", "--threads", "1"}).exit_code,
+      0);
+  ASSERT_EQ(run({"gen", "--pile", "9", "--out", path("t").string(), "--seed", "3", "--shuffle"}).exit_code, 0);
+  // The bodies are the same; the contact rows are the same rows in another
+  // order, the same order whatever the thread count.
+  EXPECT_EQ(slurp(path("s") / "bodies.csv"), slurp(path("o") / "bodies.csv"));
+  const std::string ordered = slurp(path("o") / "contacts.csv");
+  const std::string shuffled = slurp(path("s") / "contacts.csv");
+  EXPECT_NE(shuffled, ordered);
+  EXPECT_EQ(shuffled, slurp(path("t") / "contacts.csv"));
+  EXPECT_EQ(sorted_rows(shuffled), sorted_rows(ordered));
+  EXPECT_EQ(sorted_rows(ordered).size(), collide::pile_contact_count(9));
+}
+
+TEST_F(CliTest, GenPileUsageErrorsSayWhy) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"gen", "--pile", "1626", "--out", path("g").string()}, "--pile 1626 is too large: at most 1625 boxes per side"},
+      {{"gen", "--pile", "-3", "--out", path("g").string()}, "option '--pile' needs a non-negative integer"},
+      {{"gen", "--pile", "many", "--out", path("g").string()}, "option '--pile' needs a non-negative integer"},
+      {{"gen", "--pile", "--out", path("g").string()}, "option '--pile' needs a value"},
+      {{"gen", "--pile", "3", "--debris", "10", "--out", path("g").string()},
+       "give exactly one of --pairs N, --debris N and --pile S"},
+      {{"gen", "--pairs", "10", "--shuffle", "--out", path("g").string()}, "--shuffle is for --pile"},
+      {{"gen", "--debris", "10", "--shuffle", "--out", path("g").string()}, "--shuffle is for --pile"},
+      {{"gen", "--pile", "3", "--shuffle=yes", "--out", path("g").string()}, "takes no value"},
+      {{"gen", "--pile", "3"}, "missing required option '--out'"},
+  };
+  for (const auto& [args, message] : cases) {
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    const RunResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << joined << "\n" << r.err;
+    EXPECT_NE(r.err.find("usage: collide gen"), std::string::npos) << joined << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(path("g"))) << joined;
+  }
+  // The help says what S is.
+  const RunResult help = run({"gen", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("--pile S       a pile of S x S x S boxes, S boxes per side"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("--shuffle"), std::string::npos) << help.out;
+}
+
 TEST_F(CliTest, GenThenSolveChecksInBothPrecisionsAndPaths) {
-  for (const char* kind : {"--pairs", "--debris"}) {
-    ASSERT_EQ(run({"gen", kind, "2000", "--out", dir_.string(), "--seed", "11", "--friction"}).exit_code, 0);
+  // The pile: 12^3 boxes, 4896 contacts, in cell order and shuffled.
+  const std::vector<std::vector<std::string>> scenes = {
+      {"--pairs", "2000"}, {"--debris", "2000"}, {"--pile", "12"}, {"--pile", "12", "--shuffle"}};
+  for (const auto& scene : scenes) {
+    const std::string kind = scene[0] + (scene.size() > 2 ? " --shuffle" : "");
+    std::vector<std::string> args = {"gen", "--out", dir_.string(), "--seed", "11", "--friction"};
+    args.insert(args.end(), scene.begin(), scene.end());
+    ASSERT_EQ(run(args).exit_code, 0);
     for (const char* precision : {"float", "double"}) {
       for (const char* p : {"simd", "scalar"}) {
         const RunResult r =

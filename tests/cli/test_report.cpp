@@ -2,7 +2,8 @@
 //
 // One quick run (`--quick --n 20000 --json --plot`) is shared by the tests
 // of this file (it takes seconds, and every test reads the same outputs):
-//   * the JSON holds every variant: both scenes, friction off and on, the
+//   * the JSON holds every variant: the pairs, debris and pile scenes,
+//     friction off and on, the
 //     reference in long double and double, the textbook loop in float and
 //     double, and every kernel row (scalar, SIMD and accurate, float and
 //     double, every model, every thread count), plus the Bullet row when the
@@ -36,6 +37,7 @@
 
 #include "collide/eval/bandwidth.hpp"
 #include "collide/eval/error_bound.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/isa.hpp"
 #include "support/mini_json.hpp"
 #include "support/report_run.hpp"
@@ -112,7 +114,7 @@ TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
   std::size_t lines = 0;
   std::istringstream table(report_->result.out);
   for (std::string line; std::getline(table, line);) {
-    if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0) ++lines;
+    if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0 || line.rfind("pile ", 0) == 0) ++lines;
   }
   EXPECT_EQ(lines, rows().size());
 }
@@ -175,7 +177,7 @@ TEST_F(ReportRun, JsonHoldsEveryVariant) {
         << "duplicate row " << row.at("scene").str << " " << row.at("variant").str;
   }
   std::set<Key> expected;
-  for (const std::string scene : {"pairs", "debris"}) {
+  for (const std::string scene : {"pairs", "debris", "pile"}) {
     for (const bool friction : {false, true}) {
       expected.insert({scene, friction, "reference", "long double", "rigid", 1, "sse2"});
       expected.insert({scene, friction, "reference", "double", "rigid", 1, "sse2"});
@@ -219,7 +221,9 @@ TEST_F(ReportRun, ValuesAreSane) {
     SCOPED_TRACE(row.at("scene").str + " " + row.at("variant").str + " " + row.at("precision").str + " " +
                  row.at("model").str + " t" + std::to_string(static_cast<int>(row.at("threads").num)) +
                  (row.at("friction").b ? " friction" : ""));
-    EXPECT_EQ(row.at("n").num, 20000);
+    // --n 20000: the pairs and debris scenes have 20000 collisions, the pile
+    // is the largest within 20000 (19^3 boxes, 19855 contacts).
+    EXPECT_EQ(row.at("n").num, row.at("scene").str == "pile" ? 19855 : 20000);
     EXPECT_EQ(row.at("simd").b, row.at("variant").str == "simd" || row.at("variant").str == "accurate");
     ASSERT_EQ(row.at("collisions_per_second").kind, Json::number);
     EXPECT_GT(row.at("collisions_per_second").num, 0);
@@ -248,6 +252,24 @@ TEST_F(ReportRun, ValuesAreSane) {
     EXPECT_LT(row.at("angular_momentum_drift").num, 1e-5);
     EXPECT_LT(row.at("energy_drift").num, 1e-5);
   }
+}
+
+TEST_F(ReportRun, ThePileSceneIsReported) {
+  // The pile of at most min(--n, 1e6) contacts, its size in the JSON and in
+  // the table's first line, its own phase, and an error sample that is a
+  // whole pile (the largest within the sample's 20000 contacts).
+  ASSERT_TRUE(report_->json.has("pile_n")) << report_->result.err;
+  EXPECT_EQ(report_->json.at("pile_side").num, 19);
+  EXPECT_EQ(report_->json.at("pile_n").num, static_cast<double>(collide::pile_contact_count(19)));
+  EXPECT_NE(report_->result.out.find("pile scene 19855 (19^3 boxes)"), std::string::npos) << report_->result.out;
+  EXPECT_EQ(report_->json.at("phase_seconds").fields.count("pile"), 1U);
+  std::size_t pile_rows = 0;
+  for (const Json& row : rows()) {
+    if (row.at("scene").str != "pile") continue;
+    ++pile_rows;
+    EXPECT_EQ(row.at("error_sample").num, 19855) << row.at("variant").str;
+  }
+  EXPECT_GT(pile_rows, 0U);
 }
 
 TEST_F(ReportRun, ScalarAndSimdErrorsAreIdentical) {
@@ -319,6 +341,10 @@ TEST(ReportUsage, BadOptionsExitTwo) {
   EXPECT_EQ(run(dir, {"report", "--threads", "0"}).exit_code, 2);
   EXPECT_EQ(run(dir, {"report", "--n", "many"}).exit_code, 2);
   EXPECT_EQ(run(dir, {"report", "--bogus"}).exit_code, 2);
+  const RunResult pile = run(dir, {"report", "--pile-n", "0"});
+  EXPECT_EQ(pile.exit_code, 2);
+  EXPECT_NE(pile.err.find("--pile-n must be from 1 to 2^32 - 1"), std::string::npos) << pile.err;
+  EXPECT_EQ(run(dir, {"report", "--pile-n", "lots"}).exit_code, 2);
   const RunResult help = run(dir, {"report", "--help"});
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("usage: collide report"), std::string::npos);

@@ -3,13 +3,24 @@
 // What `collide gen`, the tests and the benchmarks rely on: item k is a pure
 // function of (seed, k); every contact approaches in the initial state, also
 // after rounding to float; the debris scene has its ground last and on side
-// b of every fourth contact; the inputs are valid scene values.
+// b of every fourth contact; the pile is its lattice (every contact between
+// lattice neighbours or a bottom box and the ground, each touching pair
+// once, in broadphase cell order or a permutation of it, points off the
+// line of centres); the inputs are valid scene values.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <set>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <oneapi/tbb/global_control.h>
 
 #include "collide/io/generate.hpp"
+#include "collide/model.hpp"
 
 namespace {
 
@@ -29,6 +40,20 @@ T approach_speed(const collide::Scene<T>& scene, std::size_t k) {
   point_velocity(ia, ra, ua);
   point_velocity(ib, rb, ub);
   return (ua[0] - ub[0]) * c.n.x[k] + (ua[1] - ub[1]) * c.n.y[k] + (ua[2] - ub[2]) * c.n.z[k];
+}
+
+/// u . n of one contact between two body records, in T.
+template <class T>
+T record_approach_speed(const collide::BodyRecord<T>& a, const collide::BodyRecord<T>& b,
+                        const collide::ContactRecord<T>& c) {
+  const T ra[3] = {c.c[0] - a.p[0], c.c[1] - a.p[1], c.c[2] - a.p[2]};
+  const T rb[3] = {c.c[0] - b.p[0], c.c[1] - b.p[1], c.c[2] - b.p[2]};
+  T u[3];
+  for (int j = 0; j < 3; ++j) {
+    const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+    u[j] = (a.v[j] + (a.w[j1] * ra[j2] - a.w[j2] * ra[j1])) - (b.v[j] + (b.w[j1] * rb[j2] - b.w[j2] * rb[j1]));
+  }
+  return u[0] * c.n[0] + u[1] * c.n[1] + u[2] * c.n[2];
 }
 
 template <class T>
@@ -121,6 +146,362 @@ TEST(SceneGenerator, TinyScenes) {
   EXPECT_EQ(d0.bodies.size(), 1u);
   expect_valid_and_approaching(collide::generate_debris<double>(1));
   expect_valid_and_approaching(collide::generate_debris<double>(3));
+}
+
+// ---------------------------------------------------------------------------
+// The pile.
+// ---------------------------------------------------------------------------
+
+/// Every column of two scenes holds the same bits.
+template <class T>
+bool same_bits(const collide::Scene<T>& x, const collide::Scene<T>& y) {
+  const auto bx = x.bodies.view(), by = y.bodies.view();
+  const auto cx = x.contacts.view(), cy = y.contacts.view();
+  if (bx.count != by.count || cx.count != cy.count) return false;
+  const auto same = [](const auto* p, const auto* q, std::size_t n) {
+    return n == 0 || std::memcmp(p, q, n * sizeof(*p)) == 0;
+  };
+  const std::size_t nb = bx.count, nc = cx.count;
+  return same(bx.inv_mass, by.inv_mass, nb) && same(bx.inv_inertia.x, by.inv_inertia.x, nb) &&
+         same(bx.inv_inertia.y, by.inv_inertia.y, nb) && same(bx.inv_inertia.z, by.inv_inertia.z, nb) &&
+         same(bx.q.w, by.q.w, nb) && same(bx.q.x, by.q.x, nb) && same(bx.q.y, by.q.y, nb) && same(bx.q.z, by.q.z, nb) &&
+         same(bx.p.x, by.p.x, nb) && same(bx.p.y, by.p.y, nb) && same(bx.p.z, by.p.z, nb) && same(bx.v.x, by.v.x, nb) &&
+         same(bx.v.y, by.v.y, nb) && same(bx.v.z, by.v.z, nb) && same(bx.w.x, by.w.x, nb) && same(bx.w.y, by.w.y, nb) &&
+         same(bx.w.z, by.w.z, nb) && same(cx.a, cy.a, nc) && same(cx.b, cy.b, nc) && same(cx.c.x, cy.c.x, nc) &&
+         same(cx.c.y, cy.c.y, nc) && same(cx.c.z, cy.c.z, nc) && same(cx.n.x, cy.n.x, nc) && same(cx.n.y, cy.n.y, nc) &&
+         same(cx.n.z, cy.n.z, nc) && same(cx.e, cy.e, nc) && same(cx.mu, cy.mu, nc);
+}
+
+/// The contacts of a pile as a uniform grid broadphase emits them: cell by
+/// cell, x fastest, each cell's +x, +y, +z neighbour and then the ground.
+std::vector<std::pair<std::size_t, std::size_t>> broadphase_pairs(std::size_t side) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  const std::size_t ground = side * side * side;
+  for (std::size_t z = 0; z < side; ++z) {
+    for (std::size_t y = 0; y < side; ++y) {
+      for (std::size_t x = 0; x < side; ++x) {
+        const std::size_t id = x + side * (y + side * z);
+        if (x + 1 < side) pairs.emplace_back(id, id + 1);
+        if (y + 1 < side) pairs.emplace_back(id, id + side);
+        if (z + 1 < side) pairs.emplace_back(id, id + side * side);
+        if (z == 0) pairs.emplace_back(id, ground);
+      }
+    }
+  }
+  return pairs;
+}
+
+TEST(PileScene, CountsAndBroadphaseCellOrder) {
+  for (std::size_t side = 0; side <= 7; ++side) {
+    SCOPED_TRACE(side);
+    const auto scene = collide::generate_pile<double>(side);
+    const auto expected = broadphase_pairs(side);
+    ASSERT_EQ(scene.bodies.size(), side * side * side + 1);
+    ASSERT_EQ(collide::pile_body_count(side), scene.bodies.size());
+    ASSERT_EQ(scene.contacts.size(), expected.size());
+    ASSERT_EQ(collide::pile_contact_count(side), 3 * side * side * (side - (side > 0 ? 1 : 0)) + side * side);
+    const auto c = scene.contacts.view();
+    for (std::size_t k = 0; k < expected.size(); ++k) {
+      ASSERT_EQ(c.a[k], expected[k].first) << "contact " << k;
+      ASSERT_EQ(c.b[k], expected[k].second) << "contact " << k;
+    }
+  }
+  // 100 per side: the scene of the level-schedule measurements.
+  EXPECT_EQ(collide::pile_contact_count(100), 2980000U);
+  EXPECT_EQ(collide::pile_body_count(100), 1000001U);
+}
+
+TEST(PileScene, EveryContactJoinsLatticeNeighboursOrTheGround) {
+  const std::size_t side = 9;
+  const auto scene = collide::generate_pile<double>(side, {3, true});
+  const auto b = scene.bodies.view();
+  const auto c = scene.contacts.view();
+  const std::size_t ground = side * side * side;
+  // The ground: the last body, immovable, at rest.
+  ASSERT_EQ(b.count, ground + 1);
+  EXPECT_EQ(b.inv_mass[ground], 0.0);
+  EXPECT_EQ(b.v.x[ground], 0.0);
+  EXPECT_EQ(b.v.z[ground], 0.0);
+  EXPECT_EQ(b.w.y[ground], 0.0);
+  for (std::size_t i = 0; i < ground; ++i) EXPECT_GT(b.inv_mass[i], 0.0) << i;
+  std::set<std::pair<std::size_t, std::size_t>> touching;
+  for (std::size_t k = 0; k < c.count; ++k) {
+    SCOPED_TRACE(k);
+    const std::size_t a = c.a[k], o = c.b[k];
+    ASSERT_LT(a, ground);
+    EXPECT_TRUE(touching.emplace(a, o).second) << "a second contact between " << a << " and " << o;
+    const double n[3] = {c.n.x[k], c.n.y[k], c.n.z[k]};
+    const double ra[3] = {c.c.x[k] - b.p.x[a], c.c.y[k] - b.p.y[a], c.c.z[k] - b.p.z[a]};
+    int axis = 0;  // the lattice axis of the normal
+    if (o == ground) {
+      EXPECT_EQ(a / (side * side), 0U) << "only the bottom layer touches the ground";
+      EXPECT_EQ(n[2], 1.0);  // from the ground (b) up to the box (a)
+      axis = 2;
+    } else {
+      ASSERT_LT(o, ground);
+      const double d[3] = {b.p.x[o] - b.p.x[a], b.p.y[o] - b.p.y[a], b.p.z[o] - b.p.z[a]};
+      // A +x, +y or +z neighbour: one pitch along one axis.
+      axis = d[0] == 1.0 ? 0 : d[1] == 1.0 ? 1 : 2;
+      for (int j = 0; j < 3; ++j) EXPECT_EQ(d[j], j == axis ? 1.0 : 0.0);
+      EXPECT_EQ(n[axis], -1.0);  // from the neighbour (b) towards the box (a)
+      EXPECT_EQ(o - a, axis == 0 ? 1 : axis == 1 ? side : side * side);
+    }
+    for (int j = 0; j < 3; ++j) {
+      if (j != axis) {
+        EXPECT_EQ(n[j], 0.0);
+        // Within the touching face, off the line of centres.
+        EXPECT_LE(std::fabs(ra[j]), 0.4 + 1e-12);
+      }
+    }
+    EXPECT_EQ(std::fabs(ra[axis]), 0.5) << "on the plane half way between the centres";
+    const double off = std::hypot(ra[(axis + 1) % 3], ra[(axis + 2) % 3]);
+    EXPECT_GT(off, 0.0) << "a contact point on the line of centres";
+    EXPECT_TRUE(c.e[k] >= 0 && c.e[k] < 1);
+    EXPECT_TRUE(c.mu[k] >= 0 && c.mu[k] < 1);
+  }
+  // Every lattice neighbour pair and every bottom box touches once.
+  EXPECT_EQ(touching.size(), 3 * side * side * (side - 1) + side * side);
+}
+
+TEST(PileScene, BoxesAreTiltedBoxes) {
+  const std::size_t side = 6;
+  const auto scene = collide::generate_pile<double>(side, {8, false});
+  for (std::size_t i = 0; i < side * side * side; ++i) {
+    const auto r = scene.bodies.record(i);
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(r.m >= 0.1 && r.m < 20.0001);
+    // A box of edges in [0.9, 1): moments m (b^2 + c^2) / 12, each below
+    // the sum of the other two, all different.
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_GT(r.I[j] / r.m, 2 * 0.81 / 12 * 0.9999);
+      EXPECT_LT(r.I[j] / r.m, 2.0 / 12 * 1.0001);
+      EXPECT_LT(r.I[j], r.I[(j + 1) % 3] + r.I[(j + 2) % 3]);
+    }
+    EXPECT_NE(r.I[0], r.I[1]);
+    // A small tilt: the rotation angle 2 acos(qw) is below |(0.05, 0.05, 0.05)|.
+    const double norm = std::sqrt(r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3]);
+    EXPECT_NEAR(norm, 1.0, 1e-12);
+    EXPECT_LT(2 * std::acos(std::min(1.0, r.q[0] / norm)), 0.0867);
+    EXPECT_GT(std::fabs(r.q[1]) + std::fabs(r.q[2]) + std::fabs(r.q[3]), 0.0);
+  }
+}
+
+TEST(PileScene, ApproachesInBothPrecisionsWithAMargin) {
+  for (const collide::Model model : {collide::Model::rigid, collide::Model::sphere, collide::Model::particle}) {
+    collide::GenerateOptions o{11, true, model};
+    expect_valid_and_approaching(collide::generate_pile<double>(13, o));
+    expect_valid_and_approaching(collide::generate_pile<float>(13, o));
+  }
+  // The largest pile, drawn item by item (its scene would not fit in
+  // memory): coordinates to 1625 m, the top layer falling at 1625 m/s. The
+  // documented 0.4 m/s margin holds in double and after rounding to float,
+  // on the bottom layers, the top layers and a stride through the middle.
+  const std::size_t side = collide::kMaxPileSide;
+  const std::uint64_t n = collide::pile_contact_count(side);
+  const collide::GenerateOptions o{2, false};
+  std::size_t checked = 0;
+  for (std::uint64_t k = 0; k < n; k += (k < 50000 || k + 50000 > n) ? 1 : 29989) {
+    collide::ContactRecord<double> c;
+    collide::BodyRecord<double> a, b;
+    collide::draw_pile_contact(o, side, k, c);
+    collide::draw_pile_body(o, side, c.a, a);
+    collide::draw_pile_body(o, side, c.b, b);
+    ASSERT_LT(record_approach_speed(a, b, c), -0.4) << k;
+    ASSERT_LT(record_approach_speed(collide::detail::narrow<float>(a), collide::detail::narrow<float>(b),
+                                    collide::detail::narrow<float>(c)),
+              -0.399f)
+        << k;
+    ++checked;
+  }
+  EXPECT_GT(checked, 500000U);
+  // Shuffled, its contacts come from anywhere in the pile, and approach.
+  collide::GenerateOptions shuffled = o;
+  shuffled.shuffle = true;
+  std::uint64_t top_layer = 0;
+  for (std::uint64_t k = 0; k < 20000; ++k) {
+    collide::ContactRecord<double> c;
+    collide::BodyRecord<double> a, b;
+    collide::draw_pile_contact(shuffled, side, k, c);
+    collide::draw_pile_body(shuffled, side, c.a, a);
+    collide::draw_pile_body(shuffled, side, c.b, b);
+    ASSERT_LT(record_approach_speed(a, b, c), -0.4) << k;
+    top_layer += c.a >= (side - 2) * side * side ? 1 : 0;
+  }
+  EXPECT_GT(top_layer, 0U);
+}
+
+TEST(PileScene, NeedsTheRigidModel) {
+  auto rigid = collide::generate_pile<double>(5, {4, false});
+  const auto b = rigid.bodies.view();
+  const auto c = rigid.contacts.view();
+  EXPECT_EQ(collide::choose_model(b, c), collide::Model::rigid);
+  EXPECT_FALSE(collide::model_misfit(collide::Model::sphere, b, c).empty());
+  // The pile shaped for a smaller model fits it.
+  for (const collide::Model model : {collide::Model::sphere, collide::Model::particle}) {
+    auto s = collide::generate_pile<float>(5, {4, true, model});
+    EXPECT_EQ(collide::model_misfit(model, s.bodies.view(), s.contacts.view()), "") << collide::to_string(model);
+  }
+}
+
+TEST(PileScene, PureFunctionOfSideOptionsAndSeed) {
+  const collide::GenerateOptions o{21, true};
+  const std::size_t side = 24;  // 13825 bodies, 40320 contacts: several blocks of work
+  const auto first = collide::generate_pile<double>(side, o);
+  EXPECT_TRUE(same_bits(first, collide::generate_pile<double>(side, o)));
+  {
+    oneapi::tbb::global_control one(oneapi::tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_TRUE(same_bits(first, collide::generate_pile<double>(side, o))) << "one thread";
+  }
+  {
+    oneapi::tbb::global_control four(oneapi::tbb::global_control::max_allowed_parallelism, 4);
+    EXPECT_TRUE(same_bits(first, collide::generate_pile<double>(side, o))) << "four threads";
+  }
+  // The pieces `collide gen` streams are the scene's items.
+  for (const std::uint64_t i : {0u, 1u, 600u, 13823u, 13824u}) {
+    collide::BodyRecord<double> body;
+    collide::draw_pile_body(o, side, i, body);
+    EXPECT_EQ(first.bodies.view().v.x[i], body.v[0]) << i;
+    EXPECT_EQ(first.bodies.view().q.z[i], body.q[3]) << i;
+  }
+  for (const std::uint64_t k : {0u, 5u, 20000u, 40319u}) {
+    collide::ContactRecord<double> contact;
+    collide::draw_pile_contact(o, side, k, contact);
+    const auto got = first.contacts.record(k);
+    EXPECT_EQ(got.a, contact.a);
+    EXPECT_EQ(got.b, contact.b);
+    EXPECT_EQ(got.c[1], contact.c[1]);
+    EXPECT_EQ(got.e, contact.e);
+    EXPECT_EQ(got.mu, contact.mu);
+  }
+  // Other seeds, other piles; friction changes mu only.
+  const auto other = collide::generate_pile<double>(side, {22, true});
+  EXPECT_NE(other.contacts.record(0).c[1], first.contacts.record(0).c[1]);
+  EXPECT_NE(other.bodies.record(0).m, first.bodies.record(0).m);
+  const auto frictionless = collide::generate_pile<double>(side, {21, false});
+  for (std::size_t k = 0; k < 100; ++k) {
+    EXPECT_EQ(frictionless.contacts.record(k).mu, 0.0);
+    EXPECT_GT(first.contacts.record(k).mu, 0.0);
+    EXPECT_EQ(frictionless.contacts.record(k).e, first.contacts.record(k).e);
+  }
+}
+
+TEST(PileScene, FloatIsTheDoubleDrawRoundedOnce) {
+  const collide::GenerateOptions o{6, true};
+  const std::size_t side = 11;
+  const auto f = collide::generate_pile<float>(side, o);
+  const auto d = collide::generate_pile<double>(side, o);
+  // The float scene is the double draws narrowed (scene.hpp), value by value.
+  collide::Scene<float> narrowed;
+  narrowed.bodies.resize(collide::pile_body_count(side));
+  narrowed.contacts.resize(collide::pile_contact_count(side));
+  for (std::size_t i = 0; i < narrowed.bodies.size(); ++i) {
+    collide::BodyRecord<double> body;
+    collide::draw_pile_body(o, side, i, body);
+    narrowed.bodies.set(i, collide::detail::narrow<float>(body));
+  }
+  for (std::size_t k = 0; k < narrowed.contacts.size(); ++k) {
+    collide::ContactRecord<double> contact;
+    collide::draw_pile_contact(o, side, k, contact);
+    narrowed.contacts.set(k, collide::detail::narrow<float>(contact));
+  }
+  EXPECT_TRUE(same_bits(f, narrowed));
+  // The stored columns are the double scene's, each rounded once.
+  const auto fb = f.bodies.view();
+  const auto db = d.bodies.view();
+  for (std::size_t i = 0; i < fb.count; ++i) {
+    ASSERT_EQ(fb.p.x[i], static_cast<float>(db.p.x[i]));
+    ASSERT_EQ(fb.v.z[i], static_cast<float>(db.v.z[i]));
+    ASSERT_EQ(fb.w.y[i], static_cast<float>(db.w.y[i]));
+    ASSERT_EQ(fb.q.w[i], static_cast<float>(db.q.w[i]));
+  }
+  const auto fc = f.contacts.view();
+  const auto dc = d.contacts.view();
+  for (std::size_t k = 0; k < fc.count; ++k) {
+    ASSERT_EQ(fc.a[k], dc.a[k]);
+    ASSERT_EQ(fc.b[k], dc.b[k]);
+    ASSERT_EQ(fc.c.y[k], static_cast<float>(dc.c.y[k]));
+    ASSERT_EQ(fc.n.z[k], static_cast<float>(dc.n.z[k]));
+    ASSERT_EQ(fc.e[k], static_cast<float>(dc.e[k]));
+    ASSERT_EQ(fc.mu[k], static_cast<float>(dc.mu[k]));
+  }
+}
+
+TEST(PileScene, ShuffleIsADeterministicPermutation) {
+  for (const std::size_t side : {1U, 2U, 3U, 10U, 17U}) {
+    SCOPED_TRACE(side);
+    collide::GenerateOptions o{5, true};
+    const auto ordered = collide::generate_pile<double>(side, o);
+    o.shuffle = true;
+    const auto shuffled = collide::generate_pile<double>(side, o);
+    EXPECT_TRUE(same_bits(shuffled, collide::generate_pile<double>(side, o)));
+    {
+      oneapi::tbb::global_control one(oneapi::tbb::global_control::max_allowed_parallelism, 1);
+      EXPECT_TRUE(same_bits(shuffled, collide::generate_pile<double>(side, o))) << "one thread";
+    }
+    // The same bodies; the same contacts, each once, with the same values.
+    collide::Scene<double> bodies_only = ordered;
+    bodies_only.contacts = shuffled.contacts;
+    EXPECT_TRUE(same_bits(bodies_only, shuffled));
+    const std::size_t n = ordered.contacts.size();
+    ASSERT_EQ(shuffled.contacts.size(), n);
+    std::vector<std::size_t> ordered_index(ordered.bodies.size() * 4, n);
+    const auto slot = [&](const collide::ContactRecord<double>& r) {
+      // The neighbour's direction identifies the contact of a box.
+      const std::size_t d = r.b == ordered.bodies.size() - 1 ? 3 : r.b - r.a == 1 ? 0 : r.b - r.a == side ? 1 : 2;
+      return 4 * std::size_t{r.a} + d;
+    };
+    for (std::size_t k = 0; k < n; ++k) ordered_index[slot(ordered.contacts.record(k))] = k;
+    std::vector<int> seen(n, 0);
+    std::size_t moved = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto r = shuffled.contacts.record(k);
+      const std::size_t from = ordered_index[slot(r)];
+      ASSERT_LT(from, n);
+      ++seen[from];
+      const auto o_r = ordered.contacts.record(from);
+      ASSERT_EQ(
+          std::make_tuple(r.a, r.b, r.c[0], r.c[1], r.c[2], r.n[0], r.n[1], r.n[2], r.e, r.mu),
+          std::make_tuple(o_r.a, o_r.b, o_r.c[0], o_r.c[1], o_r.c[2], o_r.n[0], o_r.n[1], o_r.n[2], o_r.e, o_r.mu));
+      moved += from != k ? 1 : 0;
+    }
+    EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int s) { return s == 1; }));
+    if (n >= 100) {
+      EXPECT_GT(moved, n * 9 / 10) << "hardly shuffled";
+    }
+    expect_valid_and_approaching(shuffled);
+  }
+  // Another seed, another order.
+  collide::GenerateOptions a{5, false}, b{6, false};
+  a.shuffle = b.shuffle = true;
+  const auto sa = collide::generate_pile<float>(10, a);
+  const auto sb = collide::generate_pile<float>(10, b);
+  std::size_t same_place = 0;
+  for (std::size_t k = 0; k < sa.contacts.size(); ++k) {
+    same_place +=
+        sa.contacts.record(k).a == sb.contacts.record(k).a && sa.contacts.record(k).b == sb.contacts.record(k).b;
+  }
+  EXPECT_LT(same_place, sa.contacts.size() / 10);
+}
+
+TEST(PileScene, SizesAndLimits) {
+  EXPECT_EQ(collide::pile_side_for_contacts(0), 0U);
+  EXPECT_EQ(collide::pile_side_for_contacts(1), 1U);
+  EXPECT_EQ(collide::pile_side_for_contacts(15), 1U);
+  EXPECT_EQ(collide::pile_side_for_contacts(16), 2U);  // 2^3 boxes: 12 + 4 contacts
+  EXPECT_EQ(collide::pile_side_for_contacts(20000), 19U);
+  EXPECT_EQ(collide::pile_side_for_contacts(1000000), 69U);
+  EXPECT_EQ(collide::pile_contact_count(69), 976005U);
+  EXPECT_EQ(collide::pile_side_for_contacts(std::size_t{1} << 62), collide::kMaxPileSide);
+  // The largest pile's ids fit 32 bits, one more box per side does not.
+  EXPECT_LE(collide::pile_body_count(collide::kMaxPileSide) - 1, std::size_t{0xFFFFFFFF});
+  EXPECT_GT(collide::pile_body_count(collide::kMaxPileSide + 1) - 1, std::size_t{0xFFFFFFFF});
+  EXPECT_THROW(collide::generate_pile<float>(collide::kMaxPileSide + 1), std::invalid_argument);
+  const auto empty = collide::generate_pile<double>(0);
+  EXPECT_EQ(empty.bodies.size(), 1U);
+  EXPECT_EQ(empty.contacts.size(), 0U);
+  EXPECT_EQ(empty.bodies.view().inv_mass[0], 0.0);
+  expect_valid_and_approaching(collide::generate_pile<double>(1));
+  expect_valid_and_approaching(collide::generate_pile<float>(2));
 }
 
 }  // namespace

@@ -183,7 +183,7 @@ def test_report_quick_rows():
     assert rows and {"scene", "variant", "model", "precision", "max_err_eps", "collisions_per_second"} <= set(rows[0])
     kernel = [r for r in rows if r["variant"] in ("scalar", "simd")]
     assert kernel and all(r["max_err_eps"] <= collide.error_bound_eps for r in kernel)
-    assert {r["scene"] for r in rows} == {"pairs", "debris"}
+    assert {r["scene"] for r in rows} == {"pairs", "debris", "pile"}
     with pytest.raises(ValueError, match="runs"):
         collide.report(n=10, runs=0)
 

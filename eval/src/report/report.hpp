@@ -1,6 +1,6 @@
 // report.hpp - the report engine: speed against error of every
 // variant of the solver (and the reference, the textbook loop, the Bullet
-// peer) on the pairs and the debris scene, as rows, optionally the hard
+// peer) on the pairs, the debris and the pile scene, as rows, optionally the hard
 // scenes of collide/eval/hard_scenes.hpp in both accuracy modes, and the writers
 // of the table, the JSON and the plot. `collide report` and collide.report() in
 // Python are thin shells over it.
@@ -28,7 +28,7 @@ namespace collide {
 
 /// One measured variant.
 struct ReportRow {
-  std::string scene;      ///< "pairs", "debris", or "file" (ReportOptions::scene_bodies)
+  std::string scene;      ///< "pairs", "debris", "pile", or "file" (ReportOptions::scene_bodies)
   std::string variant;    ///< "reference", "textbook", "scalar", "simd", "accurate" or "bullet"
   std::string model;      ///< "particle", "sphere" or "rigid"
   std::string precision;  ///< "float", "double" or "long double"
@@ -131,12 +131,14 @@ struct MachineInfo {
 /// The whole run, as the writers see it.
 struct Report {
   MachineInfo machine;
-  std::size_t n = 0;         ///< collisions of the pairs scene
-  std::size_t debris_n = 0;  ///< collisions of the debris scene
+  std::size_t n = 0;          ///< collisions of the pairs scene
+  std::size_t debris_n = 0;   ///< collisions of the debris scene
+  std::size_t pile_n = 0;     ///< collisions of the pile scene (pile_contact_count(pile_side))
+  std::size_t pile_side = 0;  ///< boxes per side of the pile scene
   std::size_t error_sample = 0;
   bool quick = false;
   double wall_seconds = 0;
-  /// Wall time of each phase ("triad", "pairs", "debris", "hard", "sweep"), for budgeting.
+  /// Wall time of each phase ("triad", "pairs", "debris", "pile", "hard", "sweep"), for budgeting.
   std::vector<std::pair<std::string, double>> phase_seconds;
   std::vector<ReportRow> rows;
   std::vector<SweepPoint> sweep;
@@ -158,13 +160,16 @@ struct ReportOptions {
   std::uint64_t seed = 1;             ///< scene seed
   bool quick = false;                 ///< a smoke run: short triad, sample of at most n
   std::size_t debris_n = 1000000;     ///< collisions of the debris scene
-  std::size_t slow_n = 500000;        ///< contacts of the slow (single-threaded, unvectorised) rows
-  std::vector<std::size_t> sweep_n;   ///< N of the throughput sweep; empty: no sweep
+  /// Collisions of the pile scene (generate_pile): the largest cubic pile
+  /// with at most this many contacts (1000000: 69^3 boxes, 976005 contacts).
+  std::size_t pile_n = 1000000;
+  std::size_t slow_n = 500000;       ///< contacts of the slow (single-threaded, unvectorised) rows
+  std::vector<std::size_t> sweep_n;  ///< N of the throughput sweep; empty: no sweep
   /// The hard section: every scene of hard::hard_scene_catalogue() in float
   /// and double, fast and accurate, SIMD at one thread (`--hard`).
   bool hard = false;
   std::size_t hard_n = 1000;  ///< pairs of each hard pair family (the shared scenes have fixed sizes)
-  /// A scene of the caller's, measured beside pairs and debris as the rows of
+  /// A scene of the caller's, measured beside the generated scenes as the rows of
   /// scene "file" (both empty: none): its bodies and contacts files, CSV or
   /// binary (.npz) by name, in float and double, its own friction, the
   /// models it fits; the error sample and the slow rows on its first

@@ -126,7 +126,8 @@ void sort_report_rows(Report& report) {
     const bool kernel = is_kernel_variant(r.variant);
     return std::make_tuple(r.scene == "pairs"    ? 0
                            : r.scene == "debris" ? 1
-                                                 : 2,
+                           : r.scene == "pile"   ? 2
+                                                 : 3,
                            r.friction ? 1 : 0, kernel ? 3 : variant_rank(r.variant), model_rank(r.model),
                            precision_rank(r.precision), variant_rank(r.variant), r.isa, r.threads);
   };
@@ -143,8 +144,10 @@ std::string format_report_table(const Report& report) {
   std::string out;
   char line[512];
   std::snprintf(line, sizeof line,
-                "collide report: pairs scene %zu collisions, debris scene %zu, error sample %zu contacts%s\n", report.n,
-                report.debris_n, report.error_sample, report.quick ? " (--quick)" : "");
+                "collide report: pairs scene %zu collisions, debris scene %zu, pile scene %zu (%zu^3 boxes), error "
+                "sample %zu contacts%s\n",
+                report.n, report.debris_n, report.pile_n, report.pile_side, report.error_sample,
+                report.quick ? " (--quick)" : "");
   out += line;
   std::snprintf(line, sizeof line, "machine: %s, %u hardware threads, L1d %s, L2 %s, L3 %s per instance; %s\n",
                 m.cpu.empty() ? "unknown CPU" : m.cpu.c_str(), m.hardware_threads, mib(m.l1d_bytes).c_str(),
@@ -269,6 +272,8 @@ std::string format_report_json(const Report& report) {
   s += "  \"command\": \"collide report\",\n";
   s += "  \"n\": " + std::to_string(report.n) + ",\n";
   s += "  \"debris_n\": " + std::to_string(report.debris_n) + ",\n";
+  s += "  \"pile_n\": " + std::to_string(report.pile_n) + ",\n";
+  s += "  \"pile_side\": " + std::to_string(report.pile_side) + ",\n";
   s += "  \"error_sample\": " + std::to_string(report.error_sample) + ",\n";
   s += std::string("  \"quick\": ") + (report.quick ? "true" : "false") + ",\n";
   s += "  \"error_bound_eps\": " + json_number(kImpulseErrorBoundEps) + ",\n";

@@ -1,6 +1,7 @@
 // report/run_report.cpp - the engine of `collide report` (and of
 // collide.report() in Python): speed against error for every variant, on the
-// pairs and the debris scene. The shells print and write what it returns.
+// pairs, the debris and the pile scene. The shells print and write what it
+// returns.
 //
 // Design notes
 // ------------
@@ -15,7 +16,8 @@
 //   same thread count at the start of the same run.
 // * Error: each variant also solves an error sample (its own scene of
 //   --sample contacts; for the pairs scene that is exactly the first pairs of
-//   the full scene, since pair k depends only on (seed, k)), and its impulses
+//   the full scene, since pair k depends only on (seed, k); for the pile, the
+//   largest pile of at most --sample contacts), and its impulses
 //   and final bodies are compared with reference_solve<long double> on
 //   exactly the same stored inputs (convert_scene, no renormalising). The
 //   error columns are defined in docs/report.md.
@@ -30,15 +32,19 @@
 //   default); the debris scene min(--n, 1M) unless --debris-n says otherwise,
 //   because its random body accesses make it 3 to 10 times slower per
 //   collision (latency-bound gathers), and 48 kernel rows of five runs of 4M
-//   debris collisions took 400 s here. The slow rows (the reference in long
-//   double and in double, the textbook loop, the Bullet peer; single-threaded
-//   by nature) are timed on the first 500k contacts only; the row's n and
+//   debris collisions took 400 s here. The pile scene likewise has at most
+//   min(--n, 1M) contacts unless --pile-n says otherwise (the largest cubic
+//   pile within it: 69^3 boxes, 976005 contacts); its contacts reach nearby
+//   bodies in cell order, but share them in chains some 9 x side batches
+//   deep. The slow rows (the reference in long double and in double, the
+//   textbook loop, the Bullet peer; single-threaded by nature) are timed on
+//   the first 500k contacts only; the row's n and
 //   note say so. Their per-collision speed does not depend on n once the
 //   scene is out of the last-level cache, which 500k contacts are in every
 //   precision (46 MB of bodies and more).
 // * The N sweep (panel 2 of the plot) runs on prefixes of one pairs scene of
 //   the largest N: the first N pairs of the pairs scene are the N-pair scene.
-// * The hard section (--hard, hard_rows.cpp) runs after the two scenes:
+// * The hard section (--hard, hard_rows.cpp) runs after the three scenes:
 //   every hard scene of collide/eval/hard_scenes.hpp in both accuracy modes.
 // * A kernel variant whose error exceeds kImpulseErrorBoundEps makes the
 //   command exit 3, like `solve --check` (and a hard row of the accurate
@@ -126,9 +132,26 @@ class Progress {
 // Scenes.
 // ---------------------------------------------------------------------------
 
-enum class SceneKind { pairs, debris, file };
+/// Contacts of the error sample: --sample, and with --quick at most the
+/// smallest scene.
+std::size_t report_sample_size(const ReportOptions& config) {
+  if (!config.quick) return config.sample;
+  return std::min({config.sample, config.n, config.debris_n, config.pile_n});
+}
+
+enum class SceneKind { pairs, debris, pile, file };
 const char* scene_name(SceneKind kind) {
-  return kind == SceneKind::pairs ? "pairs" : kind == SceneKind::debris ? "debris" : "file";
+  switch (kind) {
+    case SceneKind::pairs:
+      return "pairs";
+    case SceneKind::debris:
+      return "debris";
+    case SceneKind::pile:
+      return "pile";
+    case SceneKind::file:
+      break;
+  }
+  return "file";
 }
 
 /// The caller's scene (ReportOptions::scene_bodies, scene_contacts) in T,
@@ -174,11 +197,14 @@ Scene<T> contact_prefix(const Scene<T>& scene, std::size_t k) {
   return out;
 }
 
+/// A generated scene of `n` collisions; the pile of at most `n`, the largest
+/// cubic one (in broadphase cell order, as a user's broadphase hands it).
 template <class T>
 Scene<T> make_scene(SceneKind kind, std::size_t n, bool friction, std::uint64_t seed) {
   GenerateOptions options;
   options.seed = seed;
   options.friction = friction;
+  if (kind == SceneKind::pile) return generate_pile<T>(pile_side_for_contacts(n), options);
   return kind == SceneKind::pairs ? generate_pairs<T>(n, options) : generate_debris<T>(n, options);
 }
 
@@ -254,7 +280,7 @@ class Runner {
     };
     measure_machine();
     end_phase("triad");
-    for (const SceneKind kind : {SceneKind::pairs, SceneKind::debris}) {
+    for (const SceneKind kind : {SceneKind::pairs, SceneKind::debris, SceneKind::pile}) {
       for (const bool friction : {false, true}) {
         run_scene<double>(kind, friction);
         run_scene<float>(kind, friction);
@@ -353,7 +379,7 @@ class Runner {
   [[nodiscard]] std::size_t expected_rows() const {
     const std::size_t kernel = std::size_t{2} /*precisions*/ * 3 /*models*/ * kernel_variants().size();
     const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
-    std::size_t rows = std::size_t{2} /*scenes*/ * 2 /*friction*/ * (kernel + slow);
+    std::size_t rows = std::size_t{3} /*scenes*/ * 2 /*friction*/ * (kernel + slow);
     if (!bullet_version().empty()) ++rows;
     return rows;
   }
@@ -394,7 +420,7 @@ class Runner {
   // -- rows ------------------------------------------------------------------
 
   ReportRow new_row(SceneKind kind, const char* variant, Model model, const char* precision, bool friction, int threads,
-                    std::size_t n) {
+                    std::size_t n, std::size_t error_sample) {
     ReportRow row;
     row.scene = scene_name(kind);
     row.variant = variant;
@@ -403,7 +429,7 @@ class Runner {
     row.friction = friction;
     row.threads = threads;
     row.n = n;
-    row.error_sample = sample_size();
+    row.error_sample = error_sample;
     return row;
   }
 
@@ -417,9 +443,7 @@ class Runner {
     row.bandwidth_fraction = bw > 0 ? row.collisions_per_second * row.bytes_per_collision / bw : 0;
   }
 
-  [[nodiscard]] std::size_t sample_size() const {
-    return config_.quick ? std::min(config_.sample, std::min(config_.n, config_.debris_n)) : config_.sample;
-  }
+  [[nodiscard]] std::size_t sample_size() const { return report_sample_size(config_); }
 
   void add(ReportRow row) {
     progress_->step(row.scene + " " + row.precision + (row.friction ? " friction" : "") + ": " + row.variant + " " +
@@ -430,7 +454,9 @@ class Runner {
   template <class T>
   void run_scene(SceneKind kind, bool friction) {
     const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
-    const std::size_t n = kind == SceneKind::pairs ? config_.n : config_.debris_n;
+    const std::size_t n = kind == SceneKind::pairs    ? config_.n
+                          : kind == SceneKind::debris ? config_.debris_n
+                                                      : config_.pile_n;
     progress_->show(what + ": generating " + std::to_string(n) + " collisions");
     Scene<T> scene = make_scene<T>(kind, n, friction, config_.seed);
     Scene<T> sample = make_scene<T>(kind, sample_size(), friction, config_.seed);
@@ -490,7 +516,7 @@ class Runner {
         {
           const Solver& s = solver(path, threads, isa, accuracy);
           ReportRow row = new_row(kind, accuracy == Accuracy::accurate ? "accurate" : to_string(path), model,
-                                  precision_name<T>(), friction, threads, n);
+                                  precision_name<T>(), friction, threads, n, sample.contacts.size());
           row.simd = path == Path::simd;
           progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
           const BodyView<T> bodies = scene.bodies.view();
@@ -532,7 +558,8 @@ class Runner {
                            const ReferenceResult& reference) {
     ContactView<double> contacts = slow_contacts(scene);
     // Pairs touch only their own two bodies, so the slow prefix needs only
-    // the first 2 slow_n of them; debris contacts reach every body.
+    // the first 2 slow_n of them; debris contacts reach every body, and a
+    // pile's bottom layer the ground, its last.
     BodyView<const double> body_src = scene.bodies.view();
     if (kind == SceneKind::pairs) body_src.count = std::min(body_src.count, 2 * contacts.count);
     // A file's prefix may touch any of its bodies: only those it touches.
@@ -550,7 +577,8 @@ class Runner {
       ImpulseBuffer<L> j(ld_contacts.size());
       SavedVelocities<L> saved;
       saved.save(bodies.view(), bodies.size());
-      ReportRow row = new_row(kind, "reference", Model::rigid, "long double", friction, 1, contacts.count);
+      ReportRow row =
+          new_row(kind, "reference", Model::rigid, "long double", friction, 1, contacts.count, sample.contacts.size());
       progress_->show(row.scene + ": reference long double");
       std::vector<double> seconds = time_runs(
           config_.runs, [&] { saved.restore(bodies.view()); },
@@ -570,7 +598,8 @@ class Runner {
       ImpulseBuffer<double> j(contacts.count);
       SavedVelocities<double> saved;
       saved.save(bodies.view(), bodies.size());
-      ReportRow row = new_row(kind, "reference", Model::rigid, "double", friction, 1, contacts.count);
+      ReportRow row =
+          new_row(kind, "reference", Model::rigid, "double", friction, 1, contacts.count, sample.contacts.size());
       progress_->show(row.scene + ": reference double");
       std::vector<double> seconds = time_runs(
           config_.runs, [&] { saved.restore(bodies.view()); },
@@ -594,7 +623,8 @@ class Runner {
     const ContactView<T> contacts = slow_contacts(scene);
     const BodyView<T> bodies = scene.bodies.view();
     ImpulseBuffer<T> j(contacts.count);
-    ReportRow row = new_row(kind, "textbook", Model::rigid, precision_name<T>(), friction, 1, contacts.count);
+    ReportRow row = new_row(kind, "textbook", Model::rigid, precision_name<T>(), friction, 1, contacts.count,
+                            sample.contacts.size());
     progress_->show(row.scene + ": textbook " + row.precision);
     std::vector<double> seconds = time_runs(
         config_.runs, [&] { saved.restore(bodies); }, [&] { textbook_solve<T>(bodies, contacts, j.view()); });
@@ -686,6 +716,7 @@ Report measure_report(const ReportOptions& options) {
   };
   require(options.n >= 1 && options.n <= 0x7FFFFFFFULL, "n must be from 1 to 2^31 - 1");
   require(options.debris_n >= 1 && options.debris_n <= 0xFFFFFFFFULL, "debris_n must be from 1 to 2^32 - 1");
+  require(options.pile_n >= 1 && options.pile_n <= 0xFFFFFFFFULL, "pile_n must be from 1 to 2^32 - 1");
   require(options.sample >= 1 && options.sample <= 0x7FFFFFFFULL, "sample must be from 1 to 2^31 - 1");
   require(options.runs >= 1 && options.runs <= 1000, "runs must be from 1 to 1000");
   require(!options.threads.empty(), "threads needs at least one count");
@@ -700,8 +731,9 @@ Report measure_report(const ReportOptions& options) {
   Report report;
   report.n = options.n;
   report.debris_n = options.debris_n;
-  report.error_sample =
-      options.quick ? std::min(options.sample, std::min(options.n, options.debris_n)) : options.sample;
+  report.pile_side = pile_side_for_contacts(options.pile_n);
+  report.pile_n = pile_contact_count(report.pile_side);
+  report.error_sample = report_sample_size(options);
   report.quick = options.quick;
   report.hard_n = options.hard ? options.hard_n : 0;
   const std::string bullet = bullet_version();

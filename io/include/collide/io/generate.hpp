@@ -1,8 +1,11 @@
 // collide/io/generate.hpp - random scenes for tests, benchmarks and `collide gen`.
 //
+// Three scenes: "pairs" (independent pairs), "debris" (contacts between
+// bodies picked at random, a ground body among them) and "pile" (boxes on a
+// lattice, each touching its neighbours, the bottom layer on the ground).
 // Draws follow the source page's test program: random masses, principal
 // moments, orientations (a rotation vector), velocities, contact offsets and
-// unit normals, re-drawn until the pair approaches. Every pair is a pure
+// unit normals, re-drawn until the pair approaches. Every item is a pure
 // function of (seed, k) through a counter-based generator, so the same seed
 // gives the same scene whatever the thread count or chunking, and a file of
 // ten million pairs can be written in a stream.
@@ -26,6 +29,10 @@ struct GenerateOptions {
   /// sphere: Iy = Iz = Ix; particle: infinite moments and w = 0. Every other
   /// draw is the same, so the scenes of the three models differ only there.
   Model model = Model::rigid;
+  /// The pile scene only: its contacts in a random order (a permutation drawn
+  /// from the seed) instead of broadphase cell order; every contact's values
+  /// are the same. The pairs and debris contacts have no spatial order.
+  bool shuffle = false;
 };
 
 /// Pair k of the "pairs" scene in physical units: bodies a (id 2k) and b
@@ -55,5 +62,55 @@ void draw_debris_body(const GenerateOptions& options, std::size_t contacts, std:
 /// Contact k of the debris scene, approaching in the initial state.
 void draw_debris_contact(const GenerateOptions& options, std::size_t contacts, std::uint64_t k,
                          ContactRecord<double>& contact);
+
+/// The "pile" scene: side^3 boxes on a cubic lattice of pitch 1 m, box
+/// (ix, iy, iz) = body ix + side (iy + side iz) centred at (ix, iy, iz) + 0.5,
+/// plus one immovable ground body (the last, inverse mass 0) under the bottom
+/// layer. Each box touches its +x, +y and +z neighbours and the bottom layer
+/// touches the ground, one contact per touching pair: 3 side^2 (side - 1) +
+/// side^2 contacts. Box b of a contact is the +x, +y or +z neighbour or the
+/// ground, the normal along the lattice axis from b towards a. The contact
+/// point lies on the plane between the two centres, offset within the
+/// touching face (up to 0.4 m along each face axis), off the line of centres,
+/// so the rotational terms act and the rigid model is needed.
+///
+/// Boxes: mass in [0.1, 20) kg, edges in [0.9, 1) m, a box's principal
+/// moments m (b^2 + c^2) / 12, tilted by a rotation vector of up to 0.05 rad
+/// per axis. Velocities: the pile is compressed towards the ground under
+/// its centre, v = -k (p - (side/2, side/2, -0.5)) with k = 1/s (so
+/// neighbours close at 1 m/s and the bottom layer falls at 1 m/s), plus up to
+/// 0.1 m/s per axis, and w up to 0.25 rad/s per axis: every contact
+/// approaches by at least 0.4 m/s, also in float. e and mu are drawn as the
+/// debris scene draws them.
+///
+/// Contacts in broadphase cell order: cell by cell (x fastest, then y, then
+/// z), each cell's contacts with +x, +y, +z and the ground, the order a
+/// uniform grid broadphase emits; options.shuffle permutes them. At most
+/// kMaxPileSide boxes per side (body ids are 32-bit); std::invalid_argument
+/// beyond.
+template <class T>
+Scene<T> generate_pile(std::size_t side, const GenerateOptions& options = {});
+
+/// The largest pile: side^3 boxes and the ground have 32-bit ids.
+inline constexpr std::size_t kMaxPileSide = 1625;
+
+// The pieces of the pile scene, each a pure function of its arguments, so
+// that `collide gen --pile` can stream the files in chunks.
+
+/// Number of bodies of a pile: side^3 boxes plus the ground.
+std::size_t pile_body_count(std::size_t side);
+/// Number of contacts of a pile: 3 side^2 (side - 1) + side^2.
+std::size_t pile_contact_count(std::size_t side);
+/// The side of the largest pile with at most `contacts` contacts (0 when
+/// contacts is 0): how a scene sized in contacts, like the report's, picks
+/// its pile.
+std::size_t pile_side_for_contacts(std::size_t contacts);
+/// Body i of the pile of `side` boxes per side; the last body
+/// (i == pile_body_count(side) - 1) is the immovable ground.
+void draw_pile_body(const GenerateOptions& options, std::size_t side, std::uint64_t i, BodyRecord<double>& body);
+/// Contact k of the pile (after the shuffle, when options.shuffle is set),
+/// approaching in the initial state.
+void draw_pile_contact(const GenerateOptions& options, std::size_t side, std::uint64_t k,
+                       ContactRecord<double>& contact);
 
 }  // namespace collide
