@@ -20,7 +20,7 @@ using collide::Path;
 
 template <class T>
 bool check_scene(Kind kind, std::ostream& out) {
-  const std::size_t n = 5000;
+  const std::size_t n = is_pile(kind) ? pile_size(5000) : 5000;
   const collide::Scene<T> original = generate<T>(kind, n);
   auto run = [&](auto&& solve) {
     collide::Scene<T> scene = original;
@@ -74,7 +74,7 @@ bool check_scene(Kind kind, std::ostream& out) {
   const bool ok = bitwise && relative <= tolerance;
   char line[256];
   std::snprintf(line, sizeof line,
-                "check %-9s %s n=%zu: scalar/t:1 vs simd/t:2 %s; simd vs textbook max|diff|/max|x| = %.2e%s\n",
+                "check %-12s %s n=%zu: scalar/t:1 vs simd/t:2 %s; simd vs textbook max|diff|/max|x| = %.2e%s\n",
                 kind_name(kind), precision_tag<T>(), n, bitwise ? "bitwise equal" : "DIFFER (kernel bug?)", relative,
                 relative <= tolerance ? "" : " (TOO LARGE: kernel or textbook bug?)");
   out << line;
@@ -85,7 +85,7 @@ bool check_scene(Kind kind, std::ostream& out) {
 
 bool check_kernels(std::ostream& out) {
   bool ok = true;
-  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu}) {
+  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu, Kind::pile_shuffled}) {
     ok &= check_scene<float>(kind, out);
     ok &= check_scene<double>(kind, out);
   }

@@ -45,7 +45,9 @@ using collide::Path;
 /// 4Mi and costs tens of seconds per row.
 constexpr std::size_t kTextbookMaxN = std::size_t{1} << 22;
 
-bool is_target_size(std::size_t n) { return n == kCacheN || n == kStreamN; }
+bool is_target_size(std::size_t n) {
+  return n == kCacheN || n == kStreamN || n == pile_size(kCacheN) || n == pile_size(kStreamN);
+}
 
 template <class F>
 void add_row(const std::string& name, F&& f) {
@@ -73,7 +75,7 @@ void register_group(Kind kind, std::size_t n) {
     for (const collide::Isa isa :
          {collide::Isa::sse2, collide::Isa::avx2, collide::Isa::avx512, collide::Isa::automatic}) {
       if (!collide::isa_supported(isa)) continue;
-      const int threads = n == kCacheN ? 1 : 2;
+      const int threads = n <= kCacheN ? 1 : 2;
       add_row(isa_name(kind, precision, isa, threads, n),
               [=](benchmark::State& s) { solve_row<T>(s, kind, n, Path::simd, threads, isa); });
     }
@@ -151,15 +153,9 @@ void register_rows(const Options& options, std::size_t file_contacts) {
     }
   }
 
-  // The caller's scene, in each precision run, at its own N.
-  if (file_contacts > 0) {
-    register_group<float>(Kind::file, file_contacts);
-    if (!options.quick) register_group<double>(Kind::file, file_contacts);
-  }
-
-  // The body-model grid (a scene pays only for what it models) at the
-  // two sizes its targets name: in cache and streaming.
-  for (Kind kind : {Kind::pairs, Kind::debris}) {
+  // The piles, in cell order and shuffled, at the largest pile within each
+  // target size (in cache and streaming).
+  for (Kind kind : {Kind::pile, Kind::pile_shuffled}) {
     for (int precision : {4, 8}) {
       if (precision == 8 && options.quick) {
         continue;
@@ -169,9 +165,41 @@ void register_rows(const Options& options, std::size_t file_contacts) {
           continue;
         }
         if (precision == 4) {
-          register_models<float>(kind, n);
+          register_group<float>(kind, pile_size(n));
         } else {
-          register_models<double>(kind, n);
+          register_group<double>(kind, pile_size(n));
+        }
+      }
+    }
+  }
+
+  // The caller's scene, in each precision run, at its own N.
+  if (file_contacts > 0) {
+    register_group<float>(Kind::file, file_contacts);
+    if (!options.quick) register_group<double>(Kind::file, file_contacts);
+  }
+
+  // The body-model grid (a scene pays only for what it models) at the
+  // two sizes its targets name: in cache and streaming.
+  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pile}) {
+    for (int precision : {4, 8}) {
+      if (precision == 8 && options.quick) {
+        continue;
+      }
+      for (std::size_t n : options.sizes) {
+        if (!is_target_size(n)) {
+          continue;
+        }
+        // The pile's grid in float only: the pairs and debris grids already
+        // show what double costs.
+        if (is_pile(kind) && precision == 8) {
+          continue;
+        }
+        const std::size_t scene_n = is_pile(kind) ? pile_size(n) : n;
+        if (precision == 4) {
+          register_models<float>(kind, scene_n);
+        } else {
+          register_models<double>(kind, scene_n);
         }
       }
     }

@@ -42,6 +42,10 @@ collide::Scene<T> generate(const SceneKey& key) {
   options.seed = 1;
   options.friction = key.friction || key.kind == Kind::pairs_mu;
   options.model = key.model;
+  if (is_pile(key.kind)) {
+    options.shuffle = key.kind == Kind::pile_shuffled;
+    return collide::generate_pile<T>(collide::pile_side_for_contacts(key.n), options);
+  }
   return key.kind == Kind::debris ? collide::generate_debris<T>(key.n, options)
                                   : collide::generate_pairs<T>(key.n, options);
 }
@@ -136,10 +140,18 @@ const char* kind_name(Kind kind) {
       return "debris";
     case Kind::pairs_mu:
       return "pairs+mu";
+    case Kind::pile:
+      return "pile";
+    case Kind::pile_shuffled:
+      return "pile+shuffle";
     case Kind::file:
       return "file";
   }
   return "?";
+}
+
+std::size_t pile_size(std::size_t contacts) {
+  return collide::pile_contact_count(collide::pile_side_for_contacts(contacts));
 }
 
 void set_scene_files(std::string bodies, std::string contacts) { g_files = {std::move(bodies), std::move(contacts)}; }

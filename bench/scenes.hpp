@@ -7,8 +7,12 @@
 // * Scenes: pairs (collide::generate_pairs: contact k joins bodies 2k,
 //   2k + 1), debris (collide::generate_debris: N/2 movable bodies shared at
 //   random plus one immovable ground under 25% of the contacts), pairs+mu
-//   (pairs with friction) and file (the scene of --scene, read as `collide
-//   solve` reads it). N counts contacts.
+//   (pairs with friction), pile and pile+shuffle (collide::generate_pile:
+//   boxes on a lattice, each in about six contacts, the bottom layer on a
+//   ground, the contacts in broadphase cell order or shuffled) and file (the
+//   scene of --scene, read as `collide solve` reads it). N counts contacts: a
+//   pile's N is the contact count of the largest pile within the size asked
+//   (pile_size), so that its rows' rates count the contacts solved.
 // * A scene is generated once per (scene, precision, N, model, friction) and
 //   shared by the rows that follow; only one scene is alive at a time (at
 //   N = 16M in double a pairs scene is ~6 GB), so registration keeps the rows
@@ -46,10 +50,17 @@
 
 namespace collide_bench {
 
-enum class Kind { pairs, debris, pairs_mu, file };
+enum class Kind { pairs, debris, pairs_mu, pile, pile_shuffled, file };
 
-/// The scene's part of a row name: "pairs", "debris", "pairs+mu", "file".
+/// The scene's part of a row name: "pairs", "debris", "pairs+mu", "pile",
+/// "pile+shuffle", "file".
 const char* kind_name(Kind kind);
+
+/// Whether the scene is a pile (its N is a pile's contact count).
+constexpr bool is_pile(Kind kind) { return kind == Kind::pile || kind == Kind::pile_shuffled; }
+
+/// The contact count of the largest pile with at most `contacts` contacts.
+std::size_t pile_size(std::size_t contacts);
 
 /// The precision's part of a row name: "f32" or "f64", the rows' spelling of
 /// collide::precision_name<T>() (collide/rules.hpp), which names it in
