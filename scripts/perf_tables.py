@@ -44,8 +44,9 @@ REPO = Path(__file__).resolve().parent.parent
 # "streaming", float and double for the plain solve rows, float for the rest.
 # A couple of minutes on an idle 2-core machine.
 SHORT_BENCH_FILTER = (
-    r"^(solve|isa)/(pairs|debris)/f32/"
-    r"|^solve/(pairs|debris)/f64/"
+    r"^(solve|isa)/(pairs|debris|pile|pile\+shuffle)/f32/"
+    r"|^solve/(pairs|debris|pile)/f64/"
+    r"|^schedule/(pairs|debris|pile|pile\+shuffle)/f32/"
     r"|^textbook/pairs/"
     r"|^model/(pairs|debris)/[a-z+]+/f32/simd/t:2/n:4194304"
     r"|^accurate/pairs/[a-z+]+/f32/simd/t:2/n:4194304"
@@ -64,7 +65,7 @@ PRESETS = {
     },
 }
 
-KNOWN_SCENES = ["pairs", "debris", "pile", "chain"]
+KNOWN_SCENES = ["pairs", "debris", "pile", "pile+shuffle", "chain"]
 MODELS = ["rigid", "sphere", "particle"]
 ISAS = ["sse2", "avx2", "avx512", "auto"]
 LAYOUTS = ["soa", "packed", "records"]
