@@ -125,11 +125,14 @@ def impulse_error(J, reference):
     return _collide.impulse_error(J, reference)
 
 
-def generate(kind, n, *, seed=1, model="rigid", friction=False, dtype=_np.float32):
+def generate(kind, n, *, seed=1, model="rigid", friction=False, shuffle=False, dtype=_np.float32):
     """The scenes of ``collide gen``: ``kind`` "pairs" (n independent pairs,
-    2n bodies) or "debris" (n contacts on shared bodies). Returns
-    ``(Bodies, Contacts)`` over new arrays."""
-    return _collide.generate(kind, n, seed=seed, model=model, friction=friction, dtype=dtype)
+    2n bodies), "debris" (n contacts on shared bodies) or "pile" (n x n x n
+    boxes on a lattice, each touching its neighbours, the bottom layer on an
+    immovable ground; contacts in broadphase cell order, or in a seeded random
+    order with ``shuffle=True``). Returns ``(Bodies, Contacts)`` over new
+    arrays."""
+    return _collide.generate(kind, n, seed=seed, model=model, friction=friction, shuffle=shuffle, dtype=dtype)
 
 
 def read_scene(bodies_csv, contacts_csv, dtype=_np.float64):

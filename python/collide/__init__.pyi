@@ -164,12 +164,13 @@ def solve(
 def reference_solve(bodies: AnyBodies, contacts: Contacts) -> Reference: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
 def generate(
-    kind: Literal["pairs", "debris"],
+    kind: Literal["pairs", "debris", "pile"],
     n: int,
     *,
     seed: int = 1,
     model: Literal["rigid", "sphere", "particle"] = "rigid",
     friction: bool = False,
+    shuffle: bool = False,
     dtype: type[Float] | np.dtype[Any] = ...,
 ) -> tuple[Bodies, Contacts]: ...
 def read_scene(bodies_csv: str, contacts_csv: str, dtype: type[Float] | np.dtype[Any] = ...) -> tuple[Bodies, Contacts]: ...

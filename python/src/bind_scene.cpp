@@ -93,22 +93,34 @@ Model parse_named_model(const std::string& s, const char* who) {
 namespace {
 
 py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
-                      bool friction, const py::object& dtype_in) {
+                      bool friction, bool shuffle, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris") {
-    throw py::value_error("kind must be 'pairs' or 'debris', got '" + kind + "'");
+  if (kind != "pairs" && kind != "debris" && kind != "pile") {
+    throw py::value_error("kind must be 'pairs', 'debris' or 'pile', got '" + kind + "'");
   }
-  if (n < 1 || n > 0x7FFFFFFFULL) throw py::value_error("n must be from 1 to 2^31 - 1");
+  if (kind == "pile") {
+    // As `collide gen --pile S`: n boxes per side.
+    if (n < 1 || n > kMaxPileSide) {
+      throw py::value_error("a pile has from 1 to " + std::to_string(kMaxPileSide) + " boxes per side, got " +
+                            std::to_string(n));
+    }
+  } else if (n < 1 || n > 0x7FFFFFFFULL) {
+    throw py::value_error("n must be from 1 to 2^31 - 1");
+  }
+  if (shuffle && kind != "pile") throw py::value_error("shuffle is for kind 'pile' only");
   GenerateOptions o;
   o.seed = seed;
   o.friction = friction;
+  o.shuffle = shuffle;
   o.model = parse_named_model(model, "generate");
   return with_dtype(d, [&](auto tag) {
     using T = decltype(tag);
     Scene<T> s;
     {
       py::gil_scoped_release release;
-      s = kind == "pairs" ? generate_pairs<T>(n, o) : generate_debris<T>(n, o);
+      s = kind == "pairs"    ? generate_pairs<T>(n, o)
+          : kind == "debris" ? generate_debris<T>(n, o)
+                             : generate_pile<T>(n, o);
     }
     return scene_objects<T>(std::as_const(s.bodies).view(), s.contacts.view(), d);
   });
@@ -216,7 +228,8 @@ void register_scene(py::module_& m) {
       .def("__len__", [](const Contacts& c) { return c.count; });
 
   m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
-        py::arg("model") = "rigid", py::arg("friction") = false, py::arg("dtype") = py::none());
+        py::arg("model") = "rigid", py::arg("friction") = false, py::arg("shuffle") = false,
+        py::arg("dtype") = py::none());
   m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
         py::arg("w"), py::arg("dtype"));
   m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"));

@@ -17,7 +17,8 @@ def read_impulses(path, dtype):
 
 
 @pytest.mark.parametrize("dtype,precision", [(np.float32, "float"), (np.float64, "double")])
-@pytest.mark.parametrize("scene", [["--pairs", "3000"], ["--debris", "3000", "--friction"]])
+@pytest.mark.parametrize("scene", [["--pairs", "3000"], ["--debris", "3000", "--friction"],
+                                   ["--pile", "9", "--shuffle", "--friction"]])
 def test_bitwise_equal_to_cli(cli, workdir, dtype, precision, scene):
     run([cli, "gen", *scene, "--out", workdir, "--seed", "7"])
     b_csv, c_csv = os.path.join(workdir, "bodies.csv"), os.path.join(workdir, "contacts.csv")
@@ -210,3 +211,26 @@ def test_report_hard_rows():
         collide.report_hard(n=0)
     with pytest.raises(ValueError, match="runs"):
         collide.report_hard(runs=0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_generate_pile(dtype):
+    side = 6
+    bodies, contacts = collide.generate("pile", side, friction=True, dtype=dtype)
+    shuffled, shuffled_contacts = collide.generate("pile", side, friction=True, shuffle=True, dtype=dtype)
+    assert len(bodies) == side**3 + 1 and len(contacts) == 3 * side**2 * (side - 1) + side**2
+    # The ground is the last body and immovable; every box is movable.
+    assert bodies.inv_mass[-1] == 0 and np.all(bodies.inv_mass[:-1] > 0)
+    # Shuffling moves contacts, never changes one: the same bodies, and the
+    # same contacts as a set of rows in another order.
+    assert np.array_equal(bodies.v, shuffled.v) and np.array_equal(bodies.q, shuffled.q)
+    rows = lambda c: sorted(zip(c.a.tolist(), c.b.tolist(), *c.c.tolist(), *c.n.tolist(), c.e.tolist()))
+    assert rows(contacts) == rows(shuffled_contacts)
+    assert not np.array_equal(contacts.a, shuffled_contacts.a)
+    # Contacts off the lines of centres: the rigid model, chosen by solve().
+    J, stats = collide.solve(bodies, contacts)
+    assert stats["model"] == "rigid" and stats["collisions"] == len(contacts)
+    with pytest.raises(ValueError, match="boxes per side"):
+        collide.generate("pile", 0)
+    with pytest.raises(ValueError, match="shuffle"):
+        collide.generate("pairs", 10, shuffle=True)
