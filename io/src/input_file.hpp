@@ -1,5 +1,6 @@
-// input_file.hpp - a file opened for reading, with the scene readers'
-// messages for what the operating system refuses (private to the library).
+// input_file.hpp - input files: a file opened for reading, with the scene
+// readers' messages for what the operating system refuses, and the bytes of
+// a whole input file (private to the library).
 #pragma once
 
 #include <fcntl.h>
@@ -7,8 +8,11 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstddef>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <string_view>
 
 #include "collide/io/scene_io.hpp"
 
@@ -46,6 +50,30 @@ class InputFile {
  private:
   int fd_;
   struct stat stat_ {};
+};
+
+/// The bytes of an input file (input_file.cpp), for the CSV readers. Regular
+/// files are mapped (MAP_POPULATE): the parser reads the page cache
+/// directly, where reading into a fresh buffer would first have to fault in
+/// and zero as much anonymous memory as the file is large, which costs more
+/// than parsing on a VM. Pipes and devices are read into a growing buffer.
+/// (A mapped file truncated by another process while it is parsed raises
+/// SIGBUS; inputs are not expected to change under the tool.)
+class FileBuffer {
+ public:
+  explicit FileBuffer(const std::string& path);
+  ~FileBuffer();
+  FileBuffer(const FileBuffer&) = delete;
+  FileBuffer& operator=(const FileBuffer&) = delete;
+
+  [[nodiscard]] std::string_view view() const {
+    return {mapped_ != nullptr ? static_cast<const char*>(mapped_) : heap_.get(), size_};
+  }
+
+ private:
+  void* mapped_ = nullptr;
+  std::unique_ptr<char[]> heap_;
+  std::size_t size_ = 0;
 };
 
 }  // namespace collide::detail

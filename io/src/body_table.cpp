@@ -1,0 +1,158 @@
+// body_table.cpp - body tables in physical units and what the kernels take:
+// BodyTable's rows, the rules screened column by column (bodies_ok,
+// first_body_defect), the inverses (to_body_buffer, inverses_of) and back
+// (to_body_table) (collide/io/scene_io.hpp).
+//
+// Design notes
+// ------------
+// * The rules are rules.hpp's. bodies_ok gives body_ok's verdict for a range
+//   of rows without a branch per value, so that its loops vectorise; only a
+//   range it refuses is scanned again, body by body in order, with
+//   body_defect, so the body named does not depend on threads.
+// * Rows in parallel (tbb) over disjoint ranges: no thread writes an element
+//   another one writes, so the result is the same for any thread count.
+#include "collide/io/scene_io.hpp"
+
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <utility>
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+
+#include "collide/rules.hpp"
+#include "screen_chunks.hpp"
+
+namespace collide {
+
+template <class T>
+BodyRecord<T> BodyTable<T>::record(std::size_t i) const {
+  return columns_of(*this).record(i);
+}
+
+template <class T>
+void BodyTable<T>::push_back(const BodyRecord<T>& body) {
+  column[m].push_back(body.m);
+  for (int k = 0; k < 3; ++k) column[Ix + k].push_back(body.I[k]);
+  for (int k = 0; k < 4; ++k) column[qw + k].push_back(body.q[k]);
+  for (int k = 0; k < 3; ++k) column[px + k].push_back(body.p[k]);
+  for (int k = 0; k < 3; ++k) column[vx + k].push_back(body.v[k]);
+  for (int k = 0; k < 3; ++k) column[wx + k].push_back(body.w[k]);
+}
+
+template <class T>
+bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) noexcept {
+  // The rules of body_ok (collide/rules.hpp), one column at a time and
+  // without a branch per value, defects OR-ed into an integer so that the
+  // loops vectorise: x - x == 0 exactly when x is finite.
+  const auto finite = [](T x) { return (x - x) == T(0); };
+  unsigned bad = 0;
+  for (std::size_t k = 0; k < 4; ++k) {  // m and the moments: > 0 with a finite inverse (inf is allowed)
+    const T* x = columns.column[k];
+    for (std::size_t i = i0; i < i1; ++i) {
+      bad |= static_cast<unsigned>(!(x[i] > T(0))) | static_cast<unsigned>(!finite(T(1) / x[i]));
+    }
+  }
+  for (std::size_t k = 4; k < columns.column.size(); ++k) {
+    const T* x = columns.column[k];
+    for (std::size_t i = i0; i < i1; ++i) bad |= static_cast<unsigned>(!finite(x[i]));
+  }
+  const T *qw = columns.column[4], *qx = columns.column[5], *qy = columns.column[6], *qz = columns.column[7];
+  for (std::size_t i = i0; i < i1; ++i) {
+    const T q2 = quaternion_square(qw[i], qx[i], qy[i], qz[i]);  // quaternion_normalisable, without a branch
+    bad |= static_cast<unsigned>(!finite(q2)) | static_cast<unsigned>(!(q2 >= std::numeric_limits<T>::min()));
+  }
+  return bad == 0;
+}
+
+template <class T>
+std::optional<RowDefect> first_body_defect(const BodyColumns<T>& columns) {
+  const std::size_t n = columns.size();
+  if (detail::screen_chunks(n, [&](std::size_t i0, std::size_t i1) { return bodies_ok(columns, i0, i1); })) {
+    return std::nullopt;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (std::optional<Defect> defect = body_defect(columns.record(i))) return RowDefect{i, std::move(*defect)};
+  }
+  return std::nullopt;  // not reached: bodies_ok gives body_ok's verdicts
+}
+
+template <class T>
+BodyBuffer<T> to_body_buffer(const BodyColumns<T>& table) {
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
+  // The rules first, in parallel and without messages; the first body that
+  // breaks one goes through set(), which names its defect as it always has.
+  if (const std::optional<RowDefect> bad = first_body_defect(table)) {
+    BodyBuffer<T>(bad->row + 1).set(bad->row, table.record(bad->row));  // throws
+  }
+  BodyBuffer<T> bodies(table.size());
+  // Column by column: q, p, v and w are copied as they are, m and I
+  // inverted (inverses_of). Disjoint row ranges, so threads never share an
+  // element.
+  BodyView<T> v = bodies.view();
+  T* const copied[13] = {v.q.w, v.q.x, v.q.y, v.q.z, v.p.x, v.p.y, v.p.z, v.v.x, v.v.y, v.v.z, v.w.x, v.w.y, v.w.z};
+  oneapi::tbb::parallel_for(Range(0, table.size(), 1 << 16), [&](const Range& r) {
+    const std::size_t i0 = r.begin(), n = r.size();
+    for (std::size_t k = 0; k < 13; ++k) std::memcpy(copied[k] + i0, table.column[4 + k] + i0, n * sizeof(T));
+  });
+  inverses_of(table, v.inv_mass, v.inv_inertia);
+  return bodies;
+}
+
+template <class T>
+void inverses_of(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>& inv_inertia) {
+  using Range = oneapi::tbb::blocked_range<std::size_t>;
+  // As BodyBuffer::set: 1/inf = 0, and an immovable body has no inverse
+  // moments whatever its I (the law).
+  oneapi::tbb::parallel_for(Range(0, columns.count, 1 << 16), [&](const Range& r) {
+    const T inf = std::numeric_limits<T>::infinity();
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const T m = columns.column[0][i];
+      const bool immovable = m == inf;
+      inv_mass[i] = immovable ? T(0) : T(1) / m;
+      const T ix = columns.column[1][i], iy = columns.column[2][i], iz = columns.column[3][i];
+      inv_inertia.x[i] = immovable || ix == inf ? T(0) : T(1) / ix;
+      inv_inertia.y[i] = immovable || iy == inf ? T(0) : T(1) / iy;
+      inv_inertia.z[i] = immovable || iz == inf ? T(0) : T(1) / iz;
+    }
+  });
+}
+
+template <class T>
+BodyTable<T> to_body_table(const BodyView<const T>& bodies) {
+  using Table = BodyTable<T>;
+  Table table;
+  table.resize(bodies.count);
+  // 1/x with 1/0 = inf, as BodyBuffer::record reads a body back.
+  auto physical = [](T x) { return x == T(0) ? std::numeric_limits<T>::infinity() : T(1) / x; };
+  const T* from[Table::kCount] = {
+      bodies.inv_mass, bodies.inv_inertia.x, bodies.inv_inertia.y, bodies.inv_inertia.z, bodies.q.w, bodies.q.x,
+      bodies.q.y,      bodies.q.z,           bodies.p.x,           bodies.p.y,           bodies.p.z, bodies.v.x,
+      bodies.v.y,      bodies.v.z,           bodies.w.x,           bodies.w.y,           bodies.w.z};
+  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies.count, 1 << 14),
+                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                              for (std::size_t k = 0; k < Table::kCount; ++k) {
+                                T* to = table.column[k].data();
+                                for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                                  to[i] = k <= Table::Iz ? physical(from[k][i]) : from[k][i];
+                                }
+                              }
+                            });
+  return table;
+}
+
+#define COLLIDE_BODY_TABLE_INSTANTIATE(T)                                               \
+  template struct BodyTable<T>;                                                         \
+  template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                      \
+  template bool bodies_ok<T>(const BodyColumns<T>&, std::size_t, std::size_t) noexcept; \
+  template std::optional<RowDefect> first_body_defect<T>(const BodyColumns<T>&);        \
+  template void inverses_of<T>(const BodyColumns<T>&, T*, const Vec3Array<T>&);         \
+  template BodyTable<T> to_body_table<T>(const BodyView<const T>&);
+
+COLLIDE_BODY_TABLE_INSTANTIATE(float)
+COLLIDE_BODY_TABLE_INSTANTIATE(double)
+
+#undef COLLIDE_BODY_TABLE_INSTANTIATE
+
+}  // namespace collide
