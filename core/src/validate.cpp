@@ -5,31 +5,46 @@
 // Two passes of different kinds, so that valid input (the common case, and
 // the one whose cost every Python call pays) is cheap:
 //  * the screen: branch-free passes that only answer "all good", written on
-//    16-byte vectors (about 5x faster than the scan at 1k contacts), and run
-//    in parallel chunks on large scenes, where one core's memory bandwidth is
-//    the limit. Each screen is as strict as the scan's rule or stricter (the
-//    unit-norm screen uses a band inside the scan's tolerance; -0.0 fails the
-//    sign screen), so when every screen passes the scan would find nothing;
+//    the lane layer's lanes (lanes.hpp; 4 float or 2 double lanes in the
+//    SSE2 baseline this file is built for; about 5x faster than the scan at
+//    1k contacts), and run in parallel chunks on large scenes, where one
+//    core's memory bandwidth is the limit. Each screen is as strict as the
+//    scan's rule or stricter (the unit-norm screen uses a band inside the
+//    scan's tolerance; -0.0 fails the sign screen), so when every screen
+//    passes the scan would find nothing. A screen ORs the bits of its
+//    values into integer lanes (a bit cast of the lanes) across iterations
+//    and tests them once at the end, with no compare in the loop and no
+//    floating-point value carried from one iteration to the next. Compare
+//    masks OR-ed the same way give the same verdicts but cost more on SSE2
+//    with GCC 12's std::experimental::simd: a double mask is OR-ed lane by
+//    lane through general registers, and signbit of a double is a 64-bit
+//    integer compare that SSE2 lacks; validate() on 1k contacts ran 62-65%
+//    more instructions in double and 17% more in float (callgrind), where
+//    the bit form runs the instructions of hand-written vectors;
 //  * the scan: element by element in a fixed order, stopping at the first
 //    problem so the message names one element. It runs only when a screen
 //    fails, so the message does not depend on the screens.
 #include "collide/validate.hpp"
-#include "screen_chunks.hpp"
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <type_traits>
 #include <vector>
 
 #include "collide/rules.hpp"
+#include "lanes.hpp"
+#include "screen_chunks.hpp"
 
 namespace collide {
 namespace {
+
+namespace stdx = std::experimental;
 
 /// |q| and |n| must be 1 within the tolerance of the scene files
 /// (rules.hpp): the law normalises them.
@@ -176,55 +191,51 @@ Validation check_orientation(const View&, std::size_t) {
 // Screens: no early exit and no compare-and-branch per element; true = all good.
 // ---------------------------------------------------------------------------
 
-/// 16-byte vectors (GCC/clang vector extensions; SSE2, the x86-64 baseline
-/// this file is built for). Written out, and with no compares, because GCC
-/// does not vectorise a double compare into a reduction without SSE4.1.
+/// The lanes of the screens: the lane layer's (lanes.hpp) for the ISA this
+/// file is built for, the x86-64 baseline SSE2: 4 float or 2 double lanes.
 template <class T>
-struct Lanes;
-template <>
-struct Lanes<float> {
-  typedef float V __attribute__((vector_size(16)));
-  typedef std::int32_t M __attribute__((vector_size(16)));
-};
-template <>
-struct Lanes<double> {
-  typedef double V __attribute__((vector_size(16)));
-  typedef std::int64_t M __attribute__((vector_size(16)));
-};
+using Lanes = detail::SimdLanes<T>;
 
-/// A screen over vectors of T with no compares and no floating-point chain
-/// across iterations: `finite` ors the bits of x * 0, which is +-0 for
-/// finite x and NaN for inf or NaN; `nonnegative` ors the bits of values
-/// that must be >= 0 (so -0.0, which the scan accepts, fails the screen and
-/// is left to the scan).
+/// Integer lanes as wide as the values of V, for their bits.
+template <class V>
+using BitLanes =
+    stdx::rebind_simd_t<std::conditional_t<sizeof(typename V::value_type) == 8, std::int64_t, std::int32_t>, V>;
+
+/// The bits of every lane of x (std::bit_cast: no instruction).
+template <class V>
+COLLIDE_LANE_INLINE BitLanes<V> bits(const V& x) {
+  static_assert(sizeof(BitLanes<V>) == sizeof(V));
+  return std::bit_cast<BitLanes<V>>(x);
+}
+
+/// The test of a screen's bits: no bit but the sign bit in `finite_bits`
+/// (the bits of values x * 0), no sign bit in `sign` (the bits of values
+/// that must be >= 0).
+template <class I>
+bool bits_ok(const I& finite_bits, const I& sign) {
+  using Int = typename I::value_type;
+  const I defects = (finite_bits & I(std::numeric_limits<Int>::max())) | (sign & I(std::numeric_limits<Int>::min()));
+  return stdx::none_of(defects != I(0));
+}
+
+/// A screen over lanes of T with no compares and no floating-point chain
+/// across iterations: the bits of the values are OR-ed into integer lanes
+/// and tested once, in ok(). `finite` ors the bits of x * 0, which is +-0
+/// for finite x and NaN for inf or NaN; `nonnegative` ors the bits of
+/// values that must be >= 0 (so -0.0, which the scan accepts, fails the
+/// screen and is left to the scan).
 template <class T>
 struct Screen {
-  using V = typename Lanes<T>::V;
-  using M = typename Lanes<T>::M;
-  static constexpr std::size_t kLanes = 16 / sizeof(T);
-  M finite_bits{};
-  M sign{};
+  using V = Lanes<T>;
+  using I = BitLanes<V>;
+  static constexpr std::size_t kLanes = V::size();
+  I finite_bits = I(0);
+  I sign = I(0);
 
-  static V load(const T* x) {
-    V v;
-    std::memcpy(&v, x, sizeof v);
-    return v;
-  }
-  static M bits(const V& v) {
-    M m;
-    std::memcpy(&m, &v, sizeof m);
-    return m;
-  }
-  void finite(const V& v) { finite_bits |= bits(v * V{}); }
+  static V load(const T* x) { return detail::load<V>(x); }
+  void finite(const V& v) { finite_bits |= bits(v * V(0)); }
   void nonnegative(const V& v) { sign |= bits(v); }
-  [[nodiscard]] bool ok() const {
-    using I = std::remove_cv_t<std::remove_reference_t<decltype(sign[0])>>;
-    bool good = true;
-    for (std::size_t k = 0; k < kLanes; ++k) {
-      good = good && (finite_bits[k] & std::numeric_limits<I>::max()) == 0 && sign[k] >= 0;
-    }
-    return good;
-  }
+  [[nodiscard]] bool ok() const { return bits_ok(finite_bits, sign); }
 };
 
 /// Every x[i] finite, and >= 0 when `nonnegative`.
@@ -248,7 +259,7 @@ bool screen_unit_interval(const T* x, std::size_t n) {
   using V = typename Screen<T>::V;
   Screen<T> s;
   std::size_t i = 0;
-  const V one = V{} + T(1);
+  const V one(1);
   for (; i + Screen<T>::kLanes <= n; i += Screen<T>::kLanes) {
     const V v = Screen<T>::load(x + i);
     s.finite(v);
@@ -271,11 +282,11 @@ constexpr double kUnitScreenHigh = (1 + 0.99 * kUnitTolerance) * (1 + 0.99 * kUn
 template <class T, std::size_t K>
 bool screen_unit(const std::array<const T*, K>& c, std::size_t n) {
   using V = typename Screen<T>::V;
-  const V lo = V{} + T(kUnitScreenLow), hi = V{} + T(kUnitScreenHigh);
+  const V lo(static_cast<T>(kUnitScreenLow)), hi(static_cast<T>(kUnitScreenHigh));
   Screen<T> s;
   std::size_t i = 0;
   for (; i + Screen<T>::kLanes <= n; i += Screen<T>::kLanes) {
-    V sum{};
+    V sum(0);
     for (const T* x : c) {
       const V v = Screen<T>::load(x + i);
       sum += v * v;
@@ -298,7 +309,7 @@ bool screen_unit(const std::array<const T*, K>& c, std::size_t n) {
 template <class T>
 bool screen_quaternion(const std::array<const T*, 4>& q, std::size_t n) {
   using V = typename Screen<T>::V;
-  const V smallest = V{} + std::numeric_limits<T>::min();
+  const V smallest(std::numeric_limits<T>::min());
   Screen<T> s;
   std::size_t i = 0;
   for (; i + Screen<T>::kLanes <= n; i += Screen<T>::kLanes) {
@@ -355,40 +366,46 @@ bool screen_bodies(const ParticleView<T>&, const std::vector<BodyField<T>>& fiel
   return screen_soa(fields, i0, i1);
 }
 
-/// Packed records [i0, i1) screened as one run of vectors: a record is a
-/// whole number of vectors, so vector j of every record holds the same
+/// Packed records [i0, i1) screened as one run of lanes: a record is a
+/// whole number of lane vectors, so vector j of every record holds the same
 /// fields, and per-position masks pick the values of the fields (the padding
 /// is never read by the kernels and may hold anything) and those that must
-/// be >= 0.
+/// be >= 0. The vectors are the screens' lanes, narrowed to a divisor of the
+/// record should this file be built for wider ones.
 template <class Record>
 bool screen_records(const PackedView<Record>& b,
                     const std::vector<BodyField<typename PackedValue<Record>::type>>& fields, std::size_t i0,
                     std::size_t i1) {
   using T = typename PackedValue<Record>::type;
   using S = Screen<T>;
-  using M = typename S::M;
-  constexpr std::size_t kVectors = sizeof(Record) / 16;
-  static_assert(sizeof(Record) % 16 == 0 && alignof(Record) >= 16);
+  constexpr std::size_t kValues = sizeof(Record) / sizeof(T);
+  constexpr std::size_t kLanes = std::gcd(S::kLanes, kValues);
+  using V = stdx::simd<T, stdx::simd_abi::deduce_t<T, kLanes>>;
+  using I = BitLanes<V>;
+  constexpr std::size_t kVectors = kValues / kLanes;
+  static_assert(sizeof(Record) == kValues * sizeof(T), "a record holds values of T only");
   if (i0 == i1) return true;
-  std::array<M, kVectors> used{};
-  std::array<M, kVectors> inverse{};
+  std::array<I, kVectors> used;
+  std::array<I, kVectors> inverse;
+  used.fill(I(0));
+  inverse.fill(I(0));
   const T* base = &b.bodies[0].v[0];
   for (const BodyField<T>& f : fields) {
-    if (f.stride != sizeof(Record) / sizeof(T)) continue;  // not in the record (a rigid view's inv_mass)
+    if (f.stride != kValues) continue;  // not in the record (a rigid view's inv_mass)
     const auto at = static_cast<std::size_t>(f.data - base);
-    used[at / S::kLanes][at % S::kLanes] = -1;
-    if (f.inverse) inverse[at / S::kLanes][at % S::kLanes] = -1;
+    used[at / kLanes][at % kLanes] = -1;
+    if (f.inverse) inverse[at / kLanes][at % kLanes] = -1;
   }
-  S s;
+  I finite_bits(0), sign(0);
   for (std::size_t i = i0; i < i1; ++i) {
     const T* r = &b.bodies[i].v[0];
     for (std::size_t j = 0; j < kVectors; ++j) {
-      const typename S::V v = S::load(r + j * S::kLanes);
-      s.finite_bits |= S::bits(v * typename S::V{}) & used[j];
-      s.sign |= S::bits(v) & inverse[j];
+      const V v = detail::load<V>(r + j * kLanes);
+      finite_bits |= bits(v * V(0)) & used[j];
+      sign |= bits(v) & inverse[j];
     }
   }
-  return s.ok();
+  return bits_ok(finite_bits, sign);
 }
 template <class T>
 bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<BodyField<T>>& fields, std::size_t i0,
