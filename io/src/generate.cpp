@@ -40,7 +40,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
-
 namespace collide {
 namespace {
 
