@@ -22,9 +22,9 @@
 #include <string>
 
 #include "collide/io/npz.hpp"
-#include "collide/rules.hpp"
 #include "collide/io/scene_io.hpp"
 #include "collide/io/scene_npz.hpp"
+#include "collide/rules.hpp"
 #include "commands.hpp"
 
 namespace collide::cli {

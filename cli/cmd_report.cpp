@@ -10,9 +10,9 @@
 
 #include "collide/eval/check.hpp"
 #include "collide/eval/error_bound.hpp"
-#include "report.hpp"
 #include "collide/io/scene_io.hpp"
 #include "commands.hpp"
+#include "report.hpp"
 
 namespace collide::cli {
 

@@ -47,11 +47,11 @@
 
 #include "collide/eval/check.hpp"
 #include "collide/eval/error_bound.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/io/scene_io.hpp"
 #include "collide/io/scene_npz.hpp"
+#include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "commands.hpp"

@@ -159,7 +159,6 @@ struct RefBody {
   }
 };
 
-
 /// The law for every contact in input order. With kErrorAnalysis, also the
 /// scales the kernels' errors are measured against (ReferenceContact); without
 /// it, the law alone: the same operations on the same values, so the two give
@@ -278,9 +277,8 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
           // impulse was off by 14 eps of |u'| (docs/collision-law.md, "The
           // friction step after the normal impulse").
           if constexpr (kErrorAnalysis) {
-            const S after_normal =
-                d.impulse_scale * compliance_times(n).norm() +
-                d.jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
+            const S after_normal = d.impulse_scale * compliance_times(n).norm() +
+                                   d.jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
             d.impulse_scale =
                 (S(1) + mu) * d.impulse_scale +
                 (d.speed_scale + speed_scale() + after_normal) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +

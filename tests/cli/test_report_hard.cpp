@@ -28,8 +28,8 @@
 
 #include "collide/eval/check.hpp"
 #include "collide/eval/hard_scenes.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"  // COLLIDE_HAS_FLOAT128
+#include "collide/model.hpp"
 #include "support/mini_json.hpp"
 #include "support/report_run.hpp"
 #include "support/run_cli.hpp"

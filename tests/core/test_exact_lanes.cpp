@@ -103,9 +103,7 @@ void check_float_transformations() {
   }
 }
 
-TEST(ExactLanes, FloatTransformationsAreErrorFreeOnTheSimdLanes) {
-  check_float_transformations<d::SimdLanes<float>>();
-}
+TEST(ExactLanes, FloatTransformationsAreErrorFreeOnTheSimdLanes) { check_float_transformations<d::SimdLanes<float>>(); }
 TEST(ExactLanes, FloatTransformationsAreErrorFreeOnTheScalarLanes) {
   check_float_transformations<d::ScalarLanes<float>>();
 }

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "collide/io/generate.hpp"
 #include "collide/eval/hard_scenes.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"

@@ -25,9 +25,9 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/model.hpp"
 #include "collide/solve.hpp"
 #include "support/error_bound.hpp"
 #include "support/scenes.hpp"

@@ -31,9 +31,9 @@
 #include <gtest/gtest.h>
 
 #include "collide/eval/error_bound.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "support/scenes.hpp"

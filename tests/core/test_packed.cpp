@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "collide/io/generate.hpp"
 #include "collide/eval/hard_scenes.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/packed.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"

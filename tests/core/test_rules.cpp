@@ -36,8 +36,8 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/rules.hpp"
 #include "collide/io/scene_io.hpp"
+#include "collide/rules.hpp"
 #include "support/csv_text.hpp"
 
 namespace collide::test {

@@ -44,9 +44,9 @@
 
 #include <gtest/gtest.h>
 
-#include "collide/packed.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/packed.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "support/error_bound.hpp"

@@ -39,10 +39,10 @@
 #include <gtest/gtest.h>
 
 #include "collide/eval/check.hpp"
-#include "collide/io/generate.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "support/error_bound.hpp"

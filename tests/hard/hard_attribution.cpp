@@ -44,9 +44,9 @@
 #include <vector>
 
 #include "collide/eval/error_bound.hpp"
-#include "collide/io/generate.hpp"
 #include "collide/eval/hard_scenes.hpp"
 #include "collide/eval/reference.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "contact_kernel.hpp"

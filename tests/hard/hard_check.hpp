@@ -33,9 +33,9 @@
 #include <gtest/gtest.h>
 
 #include "collide/eval/hard_scenes.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "support/error_bound.hpp"

@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 
 #include "collide/io/npz.hpp"
-#include "collide/rules.hpp"
 #include "collide/io/scene_io.hpp"
 #include "collide/io/scene_npz.hpp"
+#include "collide/rules.hpp"
 #include "collide/validate.hpp"
 
 namespace fs = std::filesystem;
@@ -342,7 +342,7 @@ TEST(SceneNpzRules, FirstBodyDefectIsTheFirstRowWithItsReason) {
   c.count = kN;
   for (std::size_t j = 0; j < 17; ++j) c.column[j] = b.col[j].data();
   EXPECT_FALSE(collide::first_body_defect(c).has_value());
-  b.col[0][kN - 5] = -1;                                   // m, a late row
+  b.col[0][kN - 5] = -1;                                        // m, a late row
   b.col[13][kN - 9] = std::numeric_limits<float>::quiet_NaN();  // vz, an earlier row
   const std::optional<collide::RowDefect> d = collide::first_body_defect(c);
   ASSERT_TRUE(d.has_value());

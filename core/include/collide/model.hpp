@@ -39,9 +39,9 @@
 
 #include <string>
 
+#include "collide/accuracy.hpp"
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/accuracy.hpp"
 
 namespace collide {
 

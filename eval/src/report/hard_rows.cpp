@@ -44,9 +44,9 @@
 
 #include "collide/eval/error_bound.hpp"
 #include "collide/eval/hard_scenes.hpp"
-#include "collide/isa.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/isa.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "measure.hpp"

@@ -11,8 +11,8 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/eval/reference.hpp"
-#include "report.hpp"
 #include "collide/io/scene.hpp"
+#include "report.hpp"
 
 namespace collide::report_detail {
 

@@ -70,19 +70,19 @@
 
 #include "collide/eval/bandwidth.hpp"
 #include "collide/eval/error_bound.hpp"
-#include "collide/io/generate.hpp"
-#include "collide/isa.hpp"
-#include "collide/model.hpp"
 #include "collide/eval/reference.hpp"
-#include "report.hpp"
-#include "collide/rules.hpp"
+#include "collide/eval/traffic.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/io/scene_io.hpp"
 #include "collide/io/scene_npz.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/rules.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
-#include "collide/eval/traffic.hpp"
 #include "measure.hpp"
+#include "report.hpp"
 
 namespace collide {
 

@@ -20,9 +20,9 @@
 #include <variant>
 #include <vector>
 
+#include "collide/accuracy.hpp"
 #include "collide/contacts.hpp"
 #include "collide/eval/reference.hpp"
-#include "collide/accuracy.hpp"
 #include "collide/solve.hpp"
 
 namespace collide {

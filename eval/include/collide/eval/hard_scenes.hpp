@@ -30,8 +30,8 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/model.hpp"
 #include "collide/io/scene.hpp"
+#include "collide/model.hpp"
 
 namespace collide {
 

@@ -15,7 +15,6 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 
-
 namespace collide {
 
 /// Per-contact quantities of the reference solve, for error analysis.
