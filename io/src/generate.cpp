@@ -490,17 +490,22 @@ Scene<T> generate_pairs(std::size_t pairs, const GenerateOptions& options) {
   return scene;
 }
 
-template <class T>
-Scene<T> generate_debris(std::size_t contacts, const GenerateOptions& options) {
+namespace {
+
+/// A scene of `bodies` bodies and `contacts` contacts, each drawn in double by
+/// draw_body(i, body) and draw_contact(k, contact) and stored in T. set()
+/// writes element i only, so disjoint ranges run in parallel.
+template <class T, class DrawBody, class DrawContact>
+Scene<T> draw_scene(std::size_t bodies, std::size_t contacts, const DrawBody& draw_body,
+                    const DrawContact& draw_contact) {
   Scene<T> scene;
-  const std::size_t bodies = debris_body_count(contacts);
   scene.bodies.resize(bodies);
   scene.contacts.resize(contacts);
   oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies, 4096),
                             [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
                               BodyRecord<double> body;
                               for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                                draw_debris_body(options, contacts, i, body);
+                                draw_body(i, body);
                                 scene.bodies.set(i, narrow<T>(body));
                               }
                             });
@@ -508,40 +513,35 @@ Scene<T> generate_debris(std::size_t contacts, const GenerateOptions& options) {
                             [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
                               ContactRecord<double> c;
                               for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                                draw_debris_contact(options, contacts, k, c);
+                                draw_contact(k, c);
                                 scene.contacts.set(k, narrow<T>(c));
                               }
                             });
   return scene;
 }
 
+}  // namespace
+
+template <class T>
+Scene<T> generate_debris(std::size_t contacts, const GenerateOptions& options) {
+  return draw_scene<T>(
+      debris_body_count(contacts), contacts,
+      [&](std::size_t i, BodyRecord<double>& body) { draw_debris_body(options, contacts, i, body); },
+      [&](std::size_t k, ContactRecord<double>& c) { draw_debris_contact(options, contacts, k, c); });
+}
+
 template <class T>
 Scene<T> generate_pile(std::size_t side, const GenerateOptions& options) {
   check_pile_side(side);
-  Scene<T> scene;
-  const std::size_t bodies = pile_body_count(side);
   const std::size_t contacts = pile_contact_count(side);
-  scene.bodies.resize(bodies);
-  scene.contacts.resize(contacts);
-  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, bodies, 4096),
-                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                              BodyRecord<double> body;
-                              for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                                draw_pile_body(options, side, i, body);
-                                scene.bodies.set(i, narrow<T>(body));
-                              }
-                            });
   // The permutation once for the scene rather than once per contact.
   const IndexPermutation shuffle(options.seed, contacts);
-  oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, contacts, 4096),
-                            [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                              ContactRecord<double> c;
-                              for (std::size_t k = r.begin(); k != r.end(); ++k) {
-                                draw_pile_contact_at(options, side, options.shuffle ? shuffle(k) : k, c);
-                                scene.contacts.set(k, narrow<T>(c));
-                              }
-                            });
-  return scene;
+  return draw_scene<T>(
+      pile_body_count(side), contacts,
+      [&](std::size_t i, BodyRecord<double>& body) { draw_pile_body(options, side, i, body); },
+      [&](std::size_t k, ContactRecord<double>& c) {
+        draw_pile_contact_at(options, side, options.shuffle ? shuffle(k) : k, c);
+      });
 }
 
 template Scene<float> generate_pairs<float>(std::size_t, const GenerateOptions&);
