@@ -37,7 +37,11 @@ std::string json_string(const std::string& s) {
       out += '\\';
       out += c;
     } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += format("\\u%04x", static_cast<unsigned char>(c));
+      // A control character as \u00XX (RFC 8259, section 7). Not format():
+      // it passes a double, and %x wants an unsigned int.
+      char escape[8];
+      std::snprintf(escape, sizeof escape, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += escape;
     } else {
       out += c;
     }
