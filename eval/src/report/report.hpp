@@ -60,6 +60,7 @@ struct ReportRow {
 
 /// True for the rows of collide's own kernel: "scalar", "simd" and
 /// "accurate" (the SIMD path with SolverOptions::accuracy = accurate).
+/// Defined in report_order.cpp.
 bool is_kernel_variant(const std::string& variant);
 
 /// One hard scene (collide/eval/hard_scenes.hpp, the catalogue) measured in one
@@ -188,7 +189,8 @@ Report measure_report(const ReportOptions& options);
 std::vector<HardRow> measure_hard_report(const ReportOptions& options);
 
 // ---------------------------------------------------------------------------
-// Output (report_output.cpp).
+// Output: the order (report_order.cpp), the table (report_table.cpp), the
+// JSON (report_json.cpp) and the plot (report_plot.cpp).
 // ---------------------------------------------------------------------------
 
 /// Puts the rows into the canonical order of the table and the JSON.
