@@ -786,18 +786,20 @@ def readme_block(bench_path: Path | None, report_path: Path | None, cpu=None, co
     lines = []
     solve = select(rows, family="solve", kind="simd")
     if solve:
-        n = max(r.n for r in solve if r.n)
         t = max(r.threads for r in solve if r.threads)
         body = []
         for scene in sorted({r.scene for r in solve}, key=scene_order):
+            # Each scene at the largest size it ran (a pile's size is the
+            # largest pile within the size asked, so it differs from the others').
+            n = max(r.n for r in solve if r.scene == scene and r.n)
             for prec in ("float", "double"):
                 r = find(solve, scene=scene, friction=False, precision=prec, n=n, threads=t)
                 if r:
-                    body.append([scene, prec, fmt_rate(r.rate), fmt_ratio(r.bw_frac) if r.bw_frac else ""])
+                    body.append([scene, prec, fmt_n(n), fmt_rate(r.rate), fmt_ratio(r.bw_frac) if r.bw_frac else ""])
         if body:
-            lines += [f"`collide_bench`, SIMD path, {fmt_n(n)} contacts, {t} threads, rigid bodies:", ""]
-            lines += table(["scene", "precision", "M contacts/s", "of the bandwidth bound"], body,
-                           ["l", "l", "r", "r"]) + [""]
+            lines += [f"`collide_bench`, SIMD path, the largest size run, {t} threads, rigid bodies:", ""]
+            lines += table(["scene", "precision", "contacts", "M contacts/s", "of the bandwidth bound"], body,
+                           ["l", "l", "r", "r", "r"]) + [""]
     if report:
         pairs = [r for r in report.get("rows", []) if r.get("scene") == "pairs" and not r.get("friction")]
         chosen = report_group_rows(pairs)
