@@ -163,7 +163,7 @@ if(COLLIDE_NEEDS_TBB)
     endif()
   endif()
   string(APPEND _collide_pc_tbb "-ltbb")
-  # libquadmath: the __float128 buffers and reference (core, eval); GCC's own
+  # libquadmath: the __float128 buffers and reference (eval only); GCC's own
   # runtime, in the linker's default path.
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
     set(_collide_pc_quadmath "-lquadmath")
@@ -185,8 +185,7 @@ function(collide_pc_file file name description library requires libs_private)
   configure_file(${PROJECT_SOURCE_DIR}/cmake/collide.pc.in ${PROJECT_BINARY_DIR}/package/${file} @ONLY)
   install(FILES ${PROJECT_BINARY_DIR}/package/${file} DESTINATION ${COLLIDE_PC_DIR})
 endfunction()
-collide_pc_file(collide.pc collide "${PROJECT_DESCRIPTION}" collide ""
-                "${_collide_pc_tbb} ${_collide_pc_quadmath}")
+collide_pc_file(collide.pc collide "${PROJECT_DESCRIPTION}" collide "" "${_collide_pc_tbb}")
 if(TARGET collide_io)
   collide_pc_file(collide-io.pc collide-io "collide scene files (CSV, .npz) and scene generators" collide_io
                   "collide = ${PROJECT_VERSION}" "${_collide_pc_tbb} ${_collide_pc_deflate}")

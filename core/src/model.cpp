@@ -6,7 +6,8 @@
 // The figures are computed from the stored data in a type wider than the
 // kernel's (double for float, long double for double), so their own
 // rounding is far below the threshold kModelOmissionEps * eps(T) they are
-// compared with; exact zero (the old exact rules) gives 0 and always fits.
+// compared with; an exact case (equal moments, a normal through both
+// centres) gives exactly 0 and always fits.
 #include "collide/model.hpp"
 
 #include <algorithm>

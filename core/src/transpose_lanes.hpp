@@ -164,9 +164,9 @@ COLLIDE_LANE_INLINE void transpose_rows(const typename V::value_type* const* row
 /// record of S: one per block of W values that fits in the record, except a
 /// last block with W/4 values or fewer, which is cheaper lane by lane (a
 /// transpose is W loads and about W log2 W shuffles, the lane-by-lane fill W
-/// loads and inserts per value). The rule was made for the 17-value rigid
-/// float record of old (one transpose and value 16 by lanes); the records of
-/// collide/packed.hpp now have no such block, and it is kept for any record
+/// loads and inserts per value). A 17-value record on 16 lanes would take one
+/// transpose and value 16 by lanes; the records of collide/packed.hpp (16, 11
+/// and 4 values) end on no such short block, and the rule serves any record
 /// that does.
 template <std::size_t W, std::size_t N, std::size_t S>
 inline constexpr std::size_t kRecordTransposes = [] {

@@ -1,21 +1,19 @@
-// test_scene.cpp - the owning buffers and the precision conversion
-// (scene.cpp, bodies.hpp, contacts.hpp, scene.hpp).
+// test_buffers.cpp - the owning buffers of the core (core/src/buffers.cpp,
+// collide/bodies.hpp, collide/contacts.hpp).
 //
 // What this proves
 // ----------------
 // * BodyBuffer stores what the kernels consume: 1/m and 1/I, 0 for an
 //   infinite mass or moment; an immovable body (m = inf) gets zero inverse
-//   moments whatever its I; q is normalised; p, v, w are copied bit for bit
-//   (-0.0 included). record() gives the physical values back (1/0 = inf),
-//   set() overwrites one body, resize() makes identity-oriented bodies.
-// * ContactBuffer normalises n, copies everything else bit for bit; its view
-//   drops mu (frictionless) exactly when every mu is 0; record() and set()
-//   round-trip. A normal off unit by more than the files' tolerance is
+//   moments whatever its I; q is stored as given (the kernels normalise it);
+//   p, v, w are copied bit for bit (-0.0 included). record() gives the
+//   physical values back (1/0 = inf), set() overwrites one body, resize()
+//   makes identity-oriented bodies.
+// * ContactBuffer stores n as given and copies everything else bit for bit;
+//   its view drops mu (frictionless) exactly when every mu is 0; record() and
+//   set() round-trip. A normal off unit by more than the files' tolerance is
 //   refused (every rule is test_rules.cpp's).
-// * convert_scene / convert_bodies / convert_contacts copy values exactly,
-//   with no renormalisation: float -> long double -> float is the identity
-//   bit for bit, a view without e gives uniform_e in every row, a view
-//   without mu gives mu = 0.
+// The precision conversion of scenes is io's (tests/io/test_scene_convert.cpp).
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -25,19 +23,16 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
-#include "collide/io/scene.hpp"
-#include "support/scenes.hpp"
-#include "support/solve_helpers.hpp"
 
 namespace collide::test {
 namespace {
 
 template <class T>
-class SceneBuffers : public ::testing::Test {};
+class Buffers : public ::testing::Test {};
 using Precisions = ::testing::Types<float, double, long double>;
-TYPED_TEST_SUITE(SceneBuffers, Precisions);
+TYPED_TEST_SUITE(Buffers, Precisions);
 
-TYPED_TEST(SceneBuffers, BodyPushBackStoresInverses) {
+TYPED_TEST(Buffers, BodyPushBackStoresInverses) {
   using T = TypeParam;
   const T inf = std::numeric_limits<T>::infinity();
   BodyBuffer<T> b;
@@ -97,7 +92,7 @@ TYPED_TEST(SceneBuffers, BodyPushBackStoresInverses) {
   EXPECT_EQ(b.view().v.x, std::as_const(b).view().v.x);
 }
 
-TYPED_TEST(SceneBuffers, ContactPushBackStoresTheNormalAsGiven) {
+TYPED_TEST(Buffers, ContactPushBackStoresTheNormalAsGiven) {
   using T = TypeParam;
   ContactBuffer<T> c;
   ContactRecord<T> r;
@@ -143,49 +138,6 @@ TYPED_TEST(SceneBuffers, ContactPushBackStoresTheNormalAsGiven) {
   EXPECT_EQ(back.e, T(0.25));
   c.resize(3);
   EXPECT_EQ(c.view().n.z[2], T(1));
-}
-
-TEST(SceneConversion, FloatToLongDoubleAndBackIsExact) {
-  SceneOptions o;
-  o.friction = true;
-  const Scene<float> f = shared_scene<float>(500, 100, o);
-  const Scene<long double> wide = convert_scene<long double>(f);
-  const Scene<float> back = convert_scene<float>(wide);
-  EXPECT_TRUE(same_bodies(f.bodies, back.bodies));
-  const ContactView<float> x = f.contacts.view(), y = back.contacts.view();
-  ASSERT_EQ(x.count, y.count);
-  ASSERT_NE(y.mu, nullptr);
-  for (std::size_t k = 0; k < x.count; ++k) {
-    ASSERT_EQ(x.a[k], y.a[k]);
-    ASSERT_EQ(x.b[k], y.b[k]);
-    for (const auto& [p, q] :
-         {std::pair{x.c.x, y.c.x}, std::pair{x.c.y, y.c.y}, std::pair{x.c.z, y.c.z}, std::pair{x.n.x, y.n.x},
-          std::pair{x.n.y, y.n.y}, std::pair{x.n.z, y.n.z}, std::pair{x.e, y.e}, std::pair{x.mu, y.mu}}) {
-      ASSERT_TRUE(same_bits(p[k], q[k])) << "contact " << k;
-    }
-  }
-  // No renormalisation: the widened normal is the float normal exactly, even
-  // though it is not unit to long double precision.
-  const ContactView<long double> w = wide.contacts.view();
-  for (std::size_t k = 0; k < x.count; ++k) EXPECT_EQ(w.n.x[k], static_cast<long double>(x.n.x[k]));
-  // The widened q likewise.
-  EXPECT_EQ(std::as_const(wide.bodies).view().q.w[3], static_cast<long double>(std::as_const(f.bodies).view().q.w[3]));
-}
-
-TEST(SceneConversion, UniformEAndMissingMuBecomeRows) {
-  const Scene<double> s = pairs_scene<double>(10);
-  ContactView<double> v = s.contacts.view();
-  v.e = nullptr;
-  v.uniform_e = 0.375;
-  ASSERT_EQ(v.mu, nullptr);
-  const ContactBuffer<long double> c = convert_contacts<long double>(v);
-  const ContactView<long double> w = c.view();
-  ASSERT_NE(w.e, nullptr);
-  for (std::size_t k = 0; k < w.count; ++k) {
-    EXPECT_EQ(w.e[k], 0.375L);
-    EXPECT_EQ(c.record(k).mu, 0.0L);
-  }
-  EXPECT_EQ(w.mu, nullptr);
 }
 
 }  // namespace

@@ -8,8 +8,11 @@
 //   every lane: s = fl(a + b) and s + e = a + b exactly, p = fl(a * b) and
 //   p + e = a * b exactly, hi + lo = a with hi on half the significand. For
 //   float lanes "exactly" is checked in double, where these sums and
-//   products are exact; for double lanes in __float128 (113 bits), where
-//   they are exact for the operand ranges drawn here.
+//   products are exact; for double lanes in a 113-bit type (__float128, or
+//   long double where it is IEEE quad), where they are exact for the operand
+//   ranges drawn here. Where neither exists the file does not compile, so
+//   the double checks never drop out silently (a 64-bit significand cannot
+//   hold a double-double's 106 bits).
 // * Double-double +, -, * (by a double-double and by a double), / and sqrt
 //   stay within the published bounds of the algorithms (u = 2^-53: the
 //   accurate addition within 3u^2 of the exact result, relative, even under
@@ -19,6 +22,7 @@
 // * The SIMD lanes give the same bits as the scalar lanes, lane by lane: the
 //   accurate mode's answer does not depend on the ISA.
 // * AccurateLanes: widen is exact and narrow rounds once to nearest.
+#include <cfloat>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -124,10 +128,15 @@ TEST(ExactLanes, FloatWidensExactlyAndNarrowsOnceToNearest) {
   }
 }
 
-#if defined(__SIZEOF_FLOAT128__)
-// --- double lanes: exact checks in __float128 -------------------------------
+// --- double lanes: exact checks in 113 bits ---------------------------------
 
-using F128 = __float128;
+#if defined(__SIZEOF_FLOAT128__)
+using F128 = __float128;  // GCC and clang on x86-64
+#elif LDBL_MANT_DIG >= 113
+using F128 = long double;  // IEEE quad (aarch64, riscv64, s390x Linux)
+#else
+#error "test_exact_lanes needs a 113-bit type (__float128 or an IEEE quad long double) to check double lanes exactly"
+#endif
 constexpr double kU = 0x1p-53;  // unit roundoff of double
 
 F128 exact(double hi, double lo) { return F128(hi) + F128(lo); }
@@ -246,7 +255,7 @@ F128 exact_result(Op op, std::size_t i, const DoubleDoubles& x, const DoubleDoub
     case Op::div:
       return a / b;
     case Op::sqrt: {
-      // Newton on |a| in __float128 from the double root: quadratic, 3 steps
+      // Newton on |a| in F128 from the double root: quadratic, 3 steps
       // are far past 113 bits.
       const F128 m = a < 0 ? -a : a;
       F128 s = F128(std::sqrt(static_cast<double>(m)));
@@ -330,7 +339,6 @@ TEST(ExactLanes, DoubleNarrowsToTheHighWord) {
     }
   }
 }
-#endif  // __SIZEOF_FLOAT128__
 
 }  // namespace
 }  // namespace collide::test

@@ -22,10 +22,12 @@
 #include <cstdint>
 #include <vector>
 
-// __float128 (113-bit significand) exists with GCC on x86-64. The body and
-// contact buffers, and the reference (collide/eval/reference.hpp, with
-// libquadmath's sqrtq), are instantiated for it there, to judge the accurate
-// mode in double, which long double's 64-bit significand cannot.
+// __float128 (113-bit significand) exists with GCC on x86-64. collide::eval
+// instantiates the body and contact buffers and the reference
+// (collide/eval/reference.hpp, with libquadmath's sqrtq) for it there, to
+// judge the accurate mode in double, which long double's 64-bit significand
+// cannot; the core itself instantiates its buffers for float, double and long
+// double only.
 #if defined(__SIZEOF_FLOAT128__) && defined(__GNUC__) && !defined(__clang__)
 #define COLLIDE_HAS_FLOAT128 1
 #else

@@ -61,6 +61,10 @@ extern template void reference_solve<double>(const BodyView<double>&, const Cont
 extern template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
                                                   const ImpulseView<long double>&, ReferenceContact<long double>*);
 #if COLLIDE_HAS_FLOAT128
+// The reference's __float128 buffers are instantiated by collide::eval
+// (eval/src/quad_buffers.cpp), not by the core.
+extern template class BodyBuffer<__float128>;
+extern template class ContactBuffer<__float128>;
 extern template void reference_solve<__float128>(const BodyView<__float128>&, const ContactView<__float128>&,
                                                  const ImpulseView<__float128>&, ReferenceContact<__float128>*);
 #endif
