@@ -216,13 +216,29 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
   const std::size_t block = std::max<std::size_t>(width, (opt.block + width - 1) / width * width);
   const RangeKernel<T> kernel = simd ? simd_kernel<T>(table) : &solve_range_scalar<T>;
 
+  const std::size_t batches = schedule.batch_count();
   arena.execute([&] {
-    for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
+    const bool one_thread = arena.max_concurrency() == 1;
+    // Whether the one-lane kernel runs all of a batch of n contacts on this
+    // thread: one too small to fill a group of lanes, or any batch on the
+    // scalar path that does not split across threads.
+    const auto one_lane = [&](std::size_t n) { return simd ? n < width : n < 2 * block || one_thread; };
+    for (std::size_t k = 0; k < batches; ++k) {
       const std::size_t begin = schedule.batch_begin(k);
-      const std::size_t end = schedule.batch_begin(k + 1);
-      const bool contiguous = schedule.batch_is_contiguous(k);
+      std::size_t end = schedule.batch_begin(k + 1);
       const std::size_t n = end - begin;
-      if (n < 2 * block || arena.max_concurrency() == 1) {
+      if (one_lane(n) && k + 1 < batches && one_lane(schedule.batch_begin(k + 2) - end)) {
+        // A run of such batches (a chain, a stack, a column: one contact per
+        // level) goes to the one-lane kernel in one call, in schedule order.
+        // That is the law's order, and each of these contacts would have run
+        // in that kernel anyway (on the SIMD path as a range's tail), so the
+        // bits are the same; only the call and dispatch per batch are saved.
+        while (k + 1 < batches && one_lane(schedule.batch_begin(k + 2) - end)) end = schedule.batch_begin(++k + 1);
+        solve_range_scalar<T>(job, false, begin, end);
+        continue;
+      }
+      const bool contiguous = schedule.batch_is_contiguous(k);
+      if (n < 2 * block || one_thread) {
         kernel(job, contiguous, begin, end);
         continue;
       }
@@ -276,12 +292,45 @@ KernelJob<T> make_job(Model model, Accuracy accuracy, const ContactView<T>& cont
 namespace detail {
 namespace {
 
-/// Contacts of the schedule in batches that are not consecutive indices:
-/// those that reach their bodies at random.
-std::size_t scattered_contacts(const Schedule& schedule) {
+/// Positions sampled per contiguous batch by scattered_contacts.
+constexpr std::size_t kLocalitySamples = 64;
+/// A contact's body "follows" the one of the contact before it when their
+/// indices differ by less than this: the records are a few lines apart and
+/// streamed, as in the pairs layout (a difference of 2).
+constexpr std::int64_t kNearBodies = 64;
+
+/// Contacts of the schedule that reach their bodies at random: those of
+/// batches that are not consecutive contacts, and those of consecutive
+/// batches whose bodies do not follow one another. A caller who hands the
+/// contacts over already grouped by level has every batch consecutive, but
+/// the bodies of a debris scene are still read at random, and reading them
+/// in place from SoA arrays (a line per component per body) is several
+/// times slower than packing them: so consecutive batches of 1024 contacts
+/// or more are sampled at kLocalitySamples evenly spaced places, and count
+/// as scattered when most samples find both bodies far from those of the
+/// contact before. The sample reads a few hundred indices: nothing beside
+/// the solve.
+std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b) {
   std::size_t n = 0;
+  const std::uint32_t* order = schedule.order();
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
-    if (!schedule.batch_is_contiguous(k)) n += schedule.batch_begin(k + 1) - schedule.batch_begin(k);
+    const std::size_t begin = schedule.batch_begin(k);
+    const std::size_t size = schedule.batch_begin(k + 1) - begin;
+    if (!schedule.batch_is_contiguous(k)) {
+      n += size;
+      continue;
+    }
+    if (size < 1024) continue;
+    const std::size_t first = order[begin];
+    std::size_t far = 0;
+    for (std::size_t s = 0; s < kLocalitySamples; ++s) {
+      const std::size_t c = first + 1 + s * (size - 1) / kLocalitySamples;
+      const auto apart = [&](const BodyIndex* index) {
+        return std::abs(static_cast<std::int64_t>(index[c]) - static_cast<std::int64_t>(index[c - 1])) >= kNearBodies;
+      };
+      far += apart(a) && apart(b) ? 1 : 0;
+    }
+    if (2 * far > kLocalitySamples) n += size;
   }
   return n;
 }
@@ -428,7 +477,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
   detail::check_solve_input(model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
-  const std::size_t scattered = detail::scattered_contacts(schedule);
+  const std::size_t scattered = detail::scattered_contacts(schedule, contacts.a, contacts.b);
   const detail::IsaPick pick = impl_->pick<T>(model, scattered, schedule.contact_count());
   if (!detail::should_pack(impl_->options.layout, scattered, bodies.count)) {
     if constexpr (std::is_same_v<View, BodyView<T>>) {
@@ -462,7 +511,8 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   job.packed = true;
   detail::set_packed(job, bodies);
-  const detail::IsaPick pick = impl_->pick<T>(model, detail::scattered_contacts(schedule), schedule.contact_count());
+  const detail::IsaPick pick =
+      impl_->pick<T>(model, detail::scattered_contacts(schedule, contacts.a, contacts.b), schedule.contact_count());
   // The caller's records are solved in place: no buffer of the solver's is
   // used, so solves on one Solver may run at once, as on SoA views.
   return detail::run_schedule(impl_->options, pick, *impl_->arena, job, schedule);

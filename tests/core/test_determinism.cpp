@@ -6,7 +6,9 @@
 // On random scenes - pairs (one contiguous batch; bodies read by vector loads
 // and a deinterleave), pairs with a and b swapped (gathered), pairs with 10%
 // immovable bodies (vector loads, scattered stores) and shared bodies (many
-// gathered batches, one immovable ground in 25% of contacts) - in float and
+// gathered batches, one immovable ground in 25% of contacts) and chains
+// (hundreds of batches of one or two contacts, which the driver runs as one
+// stream on the one-lane kernel, between large batches) - in float and
 // double, with and without friction, with per-contact e and with
 // a uniform e (ContactView::e == nullptr):
 // * the SIMD path and the scalar path give identical bytes for every J and
@@ -39,7 +41,9 @@ namespace {
 /// first + 2l + 1 (pairs), a gather otherwise (pairs with a and b swapped,
 /// shared), and a scatter instead of an interleaved store when a group holds
 /// an immovable body (pairs with some immovable bodies).
-enum class Layout { pairs, pairs_swapped, pairs_some_immovable, shared };
+/// The chains run their runs of tiny batches on the one-lane kernel in one
+/// call (solve.cpp), which must change nothing either.
+enum class Layout { pairs, pairs_swapped, pairs_some_immovable, shared, chains };
 
 struct Config {
   Layout layout;
@@ -51,7 +55,8 @@ std::string describe(const Config& c) {
   const char* layout = c.layout == Layout::pairs                  ? "pairs"
                        : c.layout == Layout::pairs_swapped        ? "pairs-swapped"
                        : c.layout == Layout::pairs_some_immovable ? "pairs-some-immovable"
-                                                                  : "shared";
+                       : c.layout == Layout::shared               ? "shared"
+                                                                  : "chains";
   return std::string(layout) + (c.friction ? " friction" : " frictionless") +
          (c.uniform_e ? " uniform-e" : " per-contact-e");
 }
@@ -68,6 +73,13 @@ Scene<T> build(const Config& cfg, const SceneOptions& o) {
     if (cfg.layout == Layout::pairs_swapped) {
       std::swap(c.a, c.b);
       for (T& x : c.n) x = -x;  // still from b towards a
+    } else if (cfg.layout == Layout::chains && k < 500) {
+      // Contacts 0..299 chain bodies 0..300, contacts 300..499 chain bodies
+      // 1000..1200: levels 1..199 hold two contacts, 200..299 one, and the
+      // pairs of those bodies come after, in later levels.
+      c.a = static_cast<BodyIndex>(k < 300 ? k : 700 + k);
+      c.b = c.a + 1;
+      make_approach(r.bodies[c.a], r.bodies[c.b], c);
     } else if (cfg.layout == Layout::pairs_some_immovable && rng.chance(0.1)) {
       BodyRecord<T>& b = r.bodies[rng.chance(0.5) ? c.a : c.b];
       b.m = std::numeric_limits<T>::infinity();
@@ -98,6 +110,11 @@ void expect_deterministic(const Config& cfg, std::uint64_t seed) {
   if (cfg.layout == Layout::shared) {
     ASSERT_GT(schedule.batch_count(), 5u);
     ASSERT_GT(schedule.largest_batch(), 1000u);  // block = 8 really goes parallel
+  }
+  if (cfg.layout == Layout::chains) {
+    ASSERT_GE(schedule.batch_count(), 300u);
+    ASSERT_EQ(schedule.batch_begin(2) - schedule.batch_begin(1), 2u);  // runs of tiny batches...
+    ASSERT_GT(schedule.largest_batch(), 10000u);                       // ...after a large one
   }
   auto run = [&](const SolverOptions& options, BodyBuffer<T>& bodies, ImpulseBuffer<T>& j) {
     bodies = scene.bodies;
@@ -150,7 +167,8 @@ TEST_P(Determinism, DoubleIdenticalAcrossPathsThreadsAndBlocks) { expect_determi
 
 std::vector<Config> all_configs() {
   std::vector<Config> out;
-  for (const Layout layout : {Layout::pairs, Layout::pairs_swapped, Layout::pairs_some_immovable, Layout::shared}) {
+  for (const Layout layout :
+       {Layout::pairs, Layout::pairs_swapped, Layout::pairs_some_immovable, Layout::shared, Layout::chains}) {
     for (const bool friction : {false, true}) {
       for (const bool uniform_e : {false, true}) out.push_back({layout, friction, uniform_e});
     }

@@ -223,6 +223,19 @@ void shared_and_hard_scenes() {
 TEST(PackedLayout, SameBitsAsSoaSharedAndHardFloat) { shared_and_hard_scenes<float>(); }
 TEST(PackedLayout, SameBitsAsSoaSharedAndHardDouble) { shared_and_hard_scenes<double>(); }
 
+/// The scene with its contacts permuted into the order of their schedule's
+/// batches, as a caller that groups its contacts by level hands them over.
+Scene<float> grouped_by_level(Scene<float> scene) {
+  Schedule schedule;
+  schedule.build(scene.contacts.view(), scene.bodies.view());
+  Scene<float> out;
+  out.bodies = scene.bodies;
+  out.contacts.resize(scene.contacts.size());
+  for (std::size_t i = 0; i < scene.contacts.size(); ++i)
+    out.contacts.set(i, scene.contacts.record(schedule.order()[i]));
+  return out;
+}
+
 TEST(PackedLayout, AutomaticChoicePacksScatteredScenesOnly) {
   GenerateOptions g;
   g.seed = 9;
@@ -238,6 +251,34 @@ TEST(PackedLayout, AutomaticChoicePacksScatteredScenesOnly) {
   EXPECT_EQ(layout_of(generate_pairs<float>(20000, g)), BodyLayout::soa);
   // Too small to pay for packing.
   EXPECT_EQ(layout_of(generate_debris<float>(500, g)), BodyLayout::soa);
+  // Debris handed over grouped by level: every batch is consecutive contacts,
+  // but their bodies are still read at random, so the bodies are packed
+  // (solved in place, the scene ran several times slower than in input order).
+  Scene<float> grouped = grouped_by_level(generate_debris<float>(20000, g));
+  {
+    Schedule schedule;
+    schedule.build(grouped.contacts.view(), grouped.bodies.view());
+    ASSERT_GT(schedule.batch_count(), 3u);
+    for (std::size_t k = 0; k < schedule.batch_count(); ++k) ASSERT_TRUE(schedule.batch_is_contiguous(k));
+  }
+  EXPECT_EQ(layout_of(grouped), BodyLayout::packed);
+}
+
+TEST(PackedLayout, ContactsGroupedByLevelSameBitsInEitherLayout) {
+  GenerateOptions g;
+  g.seed = 10;
+  const Scene<float> scene = grouped_by_level(generate_debris<float>(20000, g));
+  Scene<float> x = scene, y = scene;
+  Schedule schedule;
+  schedule.build(x.contacts.view(), x.bodies.view());
+  ImpulseBuffer<float> jx(scene.contacts.size()), jy(scene.contacts.size());
+  EXPECT_EQ(Solver(options_for(Path::simd, 2)).solve(x.bodies.view(), x.contacts.view(), jx.view(), schedule).layout,
+            BodyLayout::packed);
+  SolverOptions soa = options_for(Path::simd, 2);
+  soa.layout = BodyLayout::soa;
+  Solver(soa).solve(y.bodies.view(), y.contacts.view(), jy.view(), schedule);
+  EXPECT_TRUE(same_bodies(x.bodies, y.bodies));
+  EXPECT_TRUE(same_impulses(jx, jy));
 }
 
 TEST(PackedLayout, SolverReusesItsBufferAcrossSizes) {

@@ -108,7 +108,9 @@ std::size_t simd_width();
 /// scattered one (scattered = true: contacts reach packed bodies at random,
 /// as in the debris scene). It is what a Solver with Isa::automatic and
 /// COLLIDE_ISA unset runs; a solve counts as scattered when most of its
-/// schedule's contacts are in non-contiguous batches.
+/// schedule's contacts reach their bodies at random: those in non-contiguous
+/// batches, and those of consecutive batches whose bodies, sampled, do not
+/// follow one another (contacts handed over grouped by level).
 ///
 /// Measured once per process at the first call for each key (thread-safe;
 /// later calls return the cached answer): every ISA the CPU has runs its
@@ -145,9 +147,10 @@ struct ExternalArena;
 /// in the caller's arena (collide/tbb.hpp), and allocates nothing while
 /// solving once its buffers are sized, so one Solver can run every frame.
 ///
-/// SoA input whose contacts reach bodies at random (the schedule has
-/// non-contiguous batches covering at least a quarter as many contacts as
-/// there are bodies; SolverOptions::layout can force either way) is packed
+/// SoA input whose contacts reach bodies at random (contacts in
+/// non-contiguous batches, or in consecutive batches whose bodies do not
+/// follow one another, at least a quarter as many as there are bodies;
+/// SolverOptions::layout can force either way) is packed
 /// into the solver's own buffer, solved there, and v, w written back: the
 /// same bits as solving in place, several times faster on scattered scenes
 /// (docs/decisions/0005-packed-records-for-scattered-contacts.md). The buffer grows to the largest scene seen and is
