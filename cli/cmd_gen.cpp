@@ -2,26 +2,18 @@
 //
 // Design notes
 // ------------
-// * Streaming: items (pairs, or the bodies then the contacts of a debris or
-//   pile scene) are
-//   generated in blocks by a tbb pipeline: blocks are drawn and formatted in
-//   parallel and written in order, with a few blocks in memory at a time, so
-//   ten million pairs need tens of megabytes, not gigabytes. Every item is a
-//   pure function of (seed, index) (generate.hpp), so the bytes do not depend
-//   on the thread count or the block size.
-// * Values are written as the shortest text that reads back to the same
-//   double (std::to_chars), inf for the ground's mass and moments.
-// * Both files go through OutputFile (temporary + rename), so an interrupted
-//   or failed run leaves no half-written scene.
-// * --format npz writes the binary scene files (collide/io/scene_npz.hpp) in
-//   --precision: the columns are drawn in parallel into memory (the same
-//   draws as the CSV, rounded to the precision) and written in one pass.
+// * A thin shell: the options become generate.hpp's draw functions, and
+//   collide/io/drawn_scene.hpp writes the scene from them, streamed in
+//   blocks for CSV (tens of megabytes for ten million pairs), drawn into
+//   columns for npz. Every item is a pure function of (seed, index), so the
+//   bytes do not depend on the thread count.
+// * Both files go through OutputFile (temporary + rename) and are committed
+//   once both are written, so an interrupted or failed run leaves no
+//   half-written scene.
 // * A progress line goes to stderr only when stderr is a terminal, so logs
 //   and tests see no carriage-return noise.
 #include <unistd.h>
 
-#include <algorithm>
-#include <array>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -30,16 +22,13 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
-#include <vector>
+#include <utility>
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/parallel_pipeline.h>
-#include <oneapi/tbb/task_arena.h>
-
+#include "collide/io/drawn_scene.hpp"
 #include "collide/io/generate.hpp"
-#include "collide/io/scene_io.hpp"
+#include "collide/io/output_file.hpp"
 #include "collide/io/scene_npz.hpp"
 #include "commands.hpp"
 
@@ -107,186 +96,42 @@ class Progress {
   std::chrono::steady_clock::time_point last_{};
 };
 
-/// The text of one block, for one or two files.
-struct BlockText {
-  std::string first, second;
+/// The progress line of each part of the scene as it is written: "pairs", or
+/// "debris bodies" then "debris contacts" (and the same for a pile).
+class PartProgress {
+ public:
+  explicit PartProgress(std::string prefix) : prefix_(std::move(prefix)) {}
+  void operator()(std::string_view part, std::size_t done, std::size_t total) {
+    if (!line_ || part != part_) {
+      line_.reset();  // ends the previous part's line
+      part_ = part;
+      line_.emplace(prefix_ + part_, total);
+    }
+    line_->update(done);
+  }
+
+ private:
+  std::string prefix_;
+  std::string part_;
+  std::optional<Progress> line_;
 };
 
-/// Runs `items` items in blocks: format(begin, end, text) in parallel,
-/// write(text, end) in block order.
-void stream_blocks(std::size_t items, std::size_t block,
-                   const std::function<void(std::size_t, std::size_t, BlockText&)>& format,
-                   const std::function<void(const BlockText&, std::size_t)>& write) {
-  const std::size_t blocks = (items + block - 1) / block;
-  const std::size_t tokens = 2 * static_cast<std::size_t>(std::max(1, oneapi::tbb::this_task_arena::max_concurrency()));
-  // One buffer per token: block b uses ring[b % tokens], free again because
-  // the in-order writer has finished block b - tokens before b is admitted.
-  std::vector<BlockText> ring(tokens);
-  std::size_t next = 0;
-  oneapi::tbb::parallel_pipeline(
-      tokens,
-      oneapi::tbb::make_filter<void, std::size_t>(oneapi::tbb::filter_mode::serial_in_order,
-                                                  [&](oneapi::tbb::flow_control& fc) -> std::size_t {
-                                                    if (next == blocks) {
-                                                      fc.stop();
-                                                      return 0;
-                                                    }
-                                                    return next++;
-                                                  }) &
-          oneapi::tbb::make_filter<std::size_t, std::size_t>(oneapi::tbb::filter_mode::parallel,
-                                                             [&](std::size_t b) {
-                                                               BlockText& text = ring[b % tokens];
-                                                               text.first.clear();
-                                                               text.second.clear();
-                                                               format(b * block, std::min(items, (b + 1) * block),
-                                                                      text);
-                                                               return b;
-                                                             }) &
-          oneapi::tbb::make_filter<std::size_t, void>(oneapi::tbb::filter_mode::serial_in_order, [&](std::size_t b) {
-            write(ring[b % tokens], std::min(items, (b + 1) * block));
-          }));
+DrawnPairs pairs_scene(std::size_t pairs, const GenerateOptions& options) {
+  return {pairs, [options](std::uint64_t k, BodyRecord<double>& a, BodyRecord<double>& b, ContactRecord<double>& c) {
+            draw_pair(options, k, a, b, c);
+          }};
 }
 
-void write_pairs(std::size_t pairs, const GenerateOptions& options, OutputFile& bodies, OutputFile& contacts) {
-  bodies.write(bodies_header());
-  contacts.write(contacts_header());
-  Progress progress("pairs", pairs);
-  stream_blocks(
-      pairs, 8192,
-      [&](std::size_t begin, std::size_t end, BlockText& text) {
-        BodyRecord<double> a, b;
-        ContactRecord<double> c;
-        for (std::size_t k = begin; k < end; ++k) {
-          draw_pair(options, k, a, b, c);
-          append_body_row(text.first, a);
-          append_body_row(text.first, b);
-          append_contact_row(text.second, c);
-        }
-      },
-      [&](const BlockText& text, std::size_t done) {
-        bodies.write(text.first);
-        contacts.write(text.second);
-        progress.update(done);
-      });
-}
-
-/// A scene drawn body by body and contact by contact (debris, pile): item
-/// i of each is a pure function of the options and i (generate.hpp).
-struct SharedBodyScene {
-  std::string name;  ///< for the progress line
-  std::size_t bodies = 0, contacts = 0;
-  std::function<void(std::uint64_t, BodyRecord<double>&)> draw_body;
-  std::function<void(std::uint64_t, ContactRecord<double>&)> draw_contact;
-};
-
-SharedBodyScene debris_scene(std::size_t count, const GenerateOptions& options) {
-  return {"debris", debris_body_count(count), count,
+DrawnScene debris_scene(std::size_t count, const GenerateOptions& options) {
+  return {debris_body_count(count), count,
           [count, options](std::uint64_t i, BodyRecord<double>& body) { draw_debris_body(options, count, i, body); },
           [count, options](std::uint64_t k, ContactRecord<double>& c) { draw_debris_contact(options, count, k, c); }};
 }
 
-SharedBodyScene pile_scene(std::size_t side, const GenerateOptions& options) {
-  return {"pile", pile_body_count(side), pile_contact_count(side),
+DrawnScene pile_scene(std::size_t side, const GenerateOptions& options) {
+  return {pile_body_count(side), pile_contact_count(side),
           [side, options](std::uint64_t i, BodyRecord<double>& body) { draw_pile_body(options, side, i, body); },
           [side, options](std::uint64_t k, ContactRecord<double>& c) { draw_pile_contact(options, side, k, c); }};
-}
-
-void write_shared(const SharedBodyScene& scene, OutputFile& bodies, OutputFile& contacts) {
-  bodies.write(bodies_header());
-  {
-    Progress progress(scene.name + " bodies", scene.bodies);
-    stream_blocks(
-        scene.bodies, 8192,
-        [&](std::size_t begin, std::size_t end, BlockText& text) {
-          BodyRecord<double> body;
-          for (std::size_t i = begin; i < end; ++i) {
-            scene.draw_body(i, body);
-            append_body_row(text.first, body);
-          }
-        },
-        [&](const BlockText& text, std::size_t done) {
-          bodies.write(text.first);
-          progress.update(done);
-        });
-  }
-  contacts.write(contacts_header());
-  Progress progress(scene.name + " contacts", scene.contacts);
-  stream_blocks(
-      scene.contacts, 8192,
-      [&](std::size_t begin, std::size_t end, BlockText& text) {
-        ContactRecord<double> c;
-        for (std::size_t k = begin; k < end; ++k) {
-          scene.draw_contact(k, c);
-          append_contact_row(text.first, c);
-        }
-      },
-      [&](const BlockText& text, std::size_t done) {
-        contacts.write(text.first);
-        progress.update(done);
-      });
-}
-
-/// Draws the scene (pairs of `pairs` pairs, or else `shared`) into columns
-/// of T and writes them as binary files.
-template <class T>
-void write_npz_scene(const SharedBodyScene* shared, std::size_t pairs, const GenerateOptions& options,
-                     OutputFile& bodies_out, OutputFile& contacts_out) {
-  const std::size_t body_count = shared ? shared->bodies : 2 * pairs;
-  const std::size_t n = shared ? shared->contacts : pairs;
-  BodyTable<T> table;
-  table.resize(body_count);
-  std::vector<BodyIndex> a(n), b(n);
-  std::array<std::vector<T>, 8> real;  // cx cy cz nx ny nz e mu
-  for (auto& c : real) c.resize(n);
-  const auto put_body = [&table](std::size_t i, const BodyRecord<double>& r) {
-    const double v[17] = {r.m,    r.I[0], r.I[1], r.I[2], r.q[0], r.q[1], r.q[2], r.q[3], r.p[0],
-                          r.p[1], r.p[2], r.v[0], r.v[1], r.v[2], r.w[0], r.w[1], r.w[2]};
-    for (std::size_t k = 0; k < 17; ++k) table.column[k][i] = static_cast<T>(v[k]);
-  };
-  const auto put_contact = [&](std::size_t k, const ContactRecord<double>& c) {
-    a[k] = c.a;
-    b[k] = c.b;
-    const double v[8] = {c.c[0], c.c[1], c.c[2], c.n[0], c.n[1], c.n[2], c.e, c.mu};
-    for (std::size_t j = 0; j < 8; ++j) real[j][k] = static_cast<T>(v[j]);
-  };
-  using Range = oneapi::tbb::blocked_range<std::size_t>;
-  if (!shared) {
-    oneapi::tbb::parallel_for(Range(0, n, 8192), [&](const Range& r) {
-      BodyRecord<double> ba, bb;
-      ContactRecord<double> c;
-      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        draw_pair(options, k, ba, bb, c);
-        put_body(2 * k, ba);
-        put_body(2 * k + 1, bb);
-        put_contact(k, c);
-      }
-    });
-  } else {
-    oneapi::tbb::parallel_for(Range(0, body_count, 8192), [&](const Range& r) {
-      BodyRecord<double> body;
-      for (std::size_t i = r.begin(); i != r.end(); ++i) {
-        shared->draw_body(i, body);
-        put_body(i, body);
-      }
-    });
-    oneapi::tbb::parallel_for(Range(0, n, 8192), [&](const Range& r) {
-      ContactRecord<double> c;
-      for (std::size_t k = r.begin(); k != r.end(); ++k) {
-        shared->draw_contact(k, c);
-        put_contact(k, c);
-      }
-    });
-  }
-  write_body_table_npz(bodies_out, columns_of(table));
-  ContactView<T> contacts;
-  contacts.count = n;
-  contacts.a = a.data();
-  contacts.b = b.data();
-  contacts.c = {real[0].data(), real[1].data(), real[2].data()};
-  contacts.n = {real[3].data(), real[4].data(), real[5].data()};
-  contacts.e = real[6].data();
-  contacts.mu = real[7].data();
-  write_contacts_npz(contacts_out, contacts);
 }
 
 }  // namespace
@@ -365,20 +210,15 @@ int run_gen(int argc, char** argv) {
   OutputFile bodies(dir + "/bodies" + suffix);
   OutputFile contacts(dir + "/contacts" + suffix);
   const auto count = static_cast<std::size_t>(n);
-  std::optional<SharedBodyScene> shared;
-  if (debris) shared = debris_scene(count, options);
-  if (pile) shared = pile_scene(count, options);
-  const SharedBodyScene* const scene = shared ? &*shared : nullptr;
-  if (format == SceneFormat::npz) {
-    if (want_float) {
-      write_npz_scene<float>(scene, count, options, bodies, contacts);
-    } else {
-      write_npz_scene<double>(scene, count, options, bodies, contacts);
-    }
-  } else if (scene) {
-    write_shared(*scene, bodies, contacts);
+  PartProgress progress(pairs ? "" : std::string(kind) + " ");
+  DrawnSceneOptions how;
+  how.format = format;
+  how.precision = want_float ? NpyType::f4 : NpyType::f8;
+  how.progress = std::ref(progress);
+  if (pairs) {
+    write_drawn_scene(pairs_scene(count, options), how, bodies, contacts);
   } else {
-    write_pairs(count, options, bodies, contacts);
+    write_drawn_scene(debris ? debris_scene(count, options) : pile_scene(count, options), how, bodies, contacts);
   }
   bodies.commit();
   contacts.commit();

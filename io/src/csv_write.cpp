@@ -6,8 +6,8 @@
 // ------------
 // * Blocks of rows are formatted in parallel with std::to_chars (shortest
 //   text that reads back to the same T, csv_fields.hpp's put_number) and
-//   written in order through a tbb pipeline, so memory stays bounded and
-//   output is identical for any thread count.
+//   written in order through a tbb pipeline (ordered_blocks.hpp), so memory
+//   stays bounded and output is identical for any thread count.
 #include "collide/io/scene_io.hpp"
 
 #include <algorithm>
@@ -16,16 +16,15 @@
 #include <string_view>
 #include <vector>
 
-#include <oneapi/tbb/parallel_pipeline.h>
-#include <oneapi/tbb/task_arena.h>
-
 #include "csv_fields.hpp"
+#include "ordered_blocks.hpp"
 
 namespace collide {
 namespace {
 
 using detail::kMaxIdChars;
 using detail::kMaxNumberChars;
+using detail::ordered_blocks;
 using detail::put_number;
 
 /// Formats rows [begin, end) with `row(p, i) -> p` appending one row of at
@@ -52,32 +51,13 @@ void emit_rows(Sink&& sink, std::string_view header, std::size_t rows, std::size
     sink(std::string_view(text));
     return;
   }
-  const std::size_t tokens = 2 * static_cast<std::size_t>(std::max(1, oneapi::tbb::this_task_arena::max_concurrency()));
-  // A ring of buffers, one per token: block b uses ring[b % tokens]; the
-  // in-order output stage guarantees block b - tokens has been written out.
-  std::vector<std::string> ring(tokens);
-  std::size_t next_block = 0;
-  oneapi::tbb::parallel_pipeline(
-      tokens,
-      oneapi::tbb::make_filter<void, std::size_t>(oneapi::tbb::filter_mode::serial_in_order,
-                                                  [&](oneapi::tbb::flow_control& fc) -> std::size_t {
-                                                    if (next_block == blocks) {
-                                                      fc.stop();
-                                                      return 0;
-                                                    }
-                                                    return next_block++;
-                                                  }) &
-          oneapi::tbb::make_filter<std::size_t, std::size_t>(
-              oneapi::tbb::filter_mode::parallel,
-              [&](std::size_t b) {
-                std::string& text = ring[b % tokens];
-                text.clear();
-                format_rows(text, b * kBlock, std::min(rows, (b + 1) * kBlock), max_row_chars, row);
-                return b;
-              }) &
-          oneapi::tbb::make_filter<std::size_t, void>(oneapi::tbb::filter_mode::serial_in_order, [&](std::size_t b) {
-            sink(std::string_view(ring[b % tokens]));
-          }));
+  ordered_blocks<std::string>(
+      rows, kBlock,
+      [&](std::size_t begin, std::size_t end, std::string& text) {
+        text.clear();
+        format_rows(text, begin, end, max_row_chars, row);
+      },
+      [&](const std::string& text, std::size_t) { sink(std::string_view(text)); });
 }
 
 template <class T>

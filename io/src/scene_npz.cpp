@@ -2,11 +2,11 @@
 //
 // Design notes
 // ------------
-// * Loading is: map the archive (npz.cpp reads only its directory and the
-//   .npy headers), check the members against the table's columns, take each
-//   column in place or convert it, then screen every row against the rules
-//   in parallel. The screen answers yes or no per chunk; only a scene with
-//   a defect is scanned again, row by row on one thread, for the first
+// * Loading is: map the archive (npz_read.cpp reads only its directory and
+//   the .npy headers), check the members against the table's columns, take
+//   each column in place or convert it, then screen every row against the
+//   rules in parallel. The screen answers yes or no per chunk; only a scene
+//   with a defect is scanned again, row by row on one thread, for the first
 //   defect and its message, so the fast path forms no message and the
 //   message does not depend on threads.
 // * A real column in the other precision is rounded to T by static_cast
