@@ -85,7 +85,9 @@ bool check_scene(Kind kind, std::ostream& out) {
 
 bool check_kernels(std::ostream& out) {
   bool ok = true;
-  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu, Kind::pile_shuffled}) {
+  // The chain: one batch per contact, the path a scene of sequential
+  // contacts takes through the kernels.
+  for (Kind kind : {Kind::pairs, Kind::debris, Kind::pairs_mu, Kind::pile_shuffled, Kind::chain}) {
     ok &= check_scene<float>(kind, out);
     ok &= check_scene<double>(kind, out);
   }

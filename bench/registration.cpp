@@ -12,6 +12,9 @@
 //                                    every ISA the CPU has, and Isa::automatic,
 //                                    at 64Ki (t:1) and 4Mi (t:2)
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
+//   then the piles' groups (pile, pile+shuffle) at the largest pile within
+//   each target size, and the chain's (float only, at the target sizes: one
+//   batch per contact, the law sequential through the row)
 //   then the group of the --scene file (scene "file", N its contacts)
 //   then the body-model grid at 64Ki and 4Mi, for each (model, friction):
 //     model/<scene>/<model>[+mu]/<prec>/simd/t:{1,2}/n:N
@@ -20,8 +23,9 @@
 //     twin/packed/<scene>/<model>/<prec>/t:{1,2}/n:N   without friction
 //     twin/pairs/<model>[+mu]/<prec>/t:{1,2}/n:N   the model's memory-only twin
 //                                    (memory_twin.hpp): the ceiling of its layout
-// pairs+mu runs at the two target sizes only. A group's rows are registered
-// together so that only one scene is alive at a time (scenes.hpp).
+// pairs+mu and the chain run at the two target sizes only. A group's rows
+// are registered together so that only one scene is alive at a time
+// (scenes.hpp).
 #include "registration.hpp"
 
 #include <benchmark/benchmark.h>
@@ -170,6 +174,14 @@ void register_rows(const Options& options, std::size_t file_contacts) {
           register_group<double>(kind, pile_size(n));
         }
       }
+    }
+  }
+
+  // The chain, in float at the target sizes: the schedule is one batch per
+  // contact, so these rows time the law run sequentially through the chain.
+  for (std::size_t n : options.sizes) {
+    if (is_target_size(n)) {
+      register_group<float>(Kind::chain, n);
     }
   }
 

@@ -46,6 +46,9 @@ collide::Scene<T> generate(const SceneKey& key) {
     options.shuffle = key.kind == Kind::pile_shuffled;
     return collide::generate_pile<T>(collide::pile_side_for_contacts(key.n), options);
   }
+  if (key.kind == Kind::chain) {
+    return collide::generate_chain<T>(key.n, options);
+  }
   return key.kind == Kind::debris ? collide::generate_debris<T>(key.n, options)
                                   : collide::generate_pairs<T>(key.n, options);
 }
@@ -144,6 +147,8 @@ const char* kind_name(Kind kind) {
       return "pile";
     case Kind::pile_shuffled:
       return "pile+shuffle";
+    case Kind::chain:
+      return "chain";
     case Kind::file:
       return "file";
   }

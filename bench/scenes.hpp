@@ -9,10 +9,13 @@
 //   random plus one immovable ground under 25% of the contacts), pairs+mu
 //   (pairs with friction), pile and pile+shuffle (collide::generate_pile:
 //   boxes on a lattice, each in about six contacts, the bottom layer on a
-//   ground, the contacts in broadphase cell order or shuffled) and file (the
-//   scene of --scene, read as `collide solve` reads it). N counts contacts: a
-//   pile's N is the contact count of the largest pile within the size asked
-//   (pile_size), so that its rows' rates count the contacts solved.
+//   ground, the contacts in broadphase cell order or shuffled), chain
+//   (collide::generate_chain: N contacts between N + 1 boxes in a
+//   staircase, no ground, so the schedule is one batch per contact and the
+//   law runs sequentially) and file (the scene of --scene, read as `collide solve`
+//   reads it). N counts contacts: a pile's N is the contact count of the
+//   largest pile within the size asked (pile_size), so that its rows' rates
+//   count the contacts solved.
 // * A scene is generated once per (scene, precision, N, model, friction) and
 //   shared by the rows that follow; only one scene is alive at a time (at
 //   N = 16M in double a pairs scene is ~6 GB), so registration keeps the rows
@@ -50,10 +53,10 @@
 
 namespace collide_bench {
 
-enum class Kind { pairs, debris, pairs_mu, pile, pile_shuffled, file };
+enum class Kind { pairs, debris, pairs_mu, pile, pile_shuffled, chain, file };
 
 /// The scene's part of a row name: "pairs", "debris", "pairs+mu", "pile",
-/// "pile+shuffle", "file".
+/// "pile+shuffle", "chain", "file".
 const char* kind_name(Kind kind);
 
 /// Whether the scene is a pile (its N is a pile's contact count).

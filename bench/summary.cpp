@@ -198,8 +198,15 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
       const std::string what = std::string("f32 simd t:2 n:4Mi, ") + kind_name(kind) + " / pairs throughput";
       target(what.c_str(), q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, 0.70, "");
     }
+    // The chain: one batch per contact, every contact waiting for the one
+    // before, so no lanes or threads across contacts; a quarter of pairs speed.
+    {
+      const Result q = rep.get(solve_name(Kind::chain, f32, Path::simd, 2, kStreamN));
+      target("f32 simd t:2 n:4Mi, chain / pairs throughput", q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, 0.25,
+             "");
+    }
     // The schedule, which a debris system rebuilds every frame.
-    for (const Kind kind : {Kind::pairs, Kind::debris, Kind::pile}) {
+    for (const Kind kind : {Kind::pairs, Kind::debris, Kind::pile, Kind::chain}) {
       const std::size_t n = is_pile(kind) ? pile_n : kStreamN;
       const Result s = rep.get(schedule_name(kind, f32, n));
       const std::string what = std::string("schedule ") + kind_name(kind) + " f32 n:4Mi, M contacts/s";

@@ -44,9 +44,9 @@ REPO = Path(__file__).resolve().parent.parent
 # "streaming", float and double for the plain solve rows, float for the rest.
 # A couple of minutes on an idle 2-core machine.
 SHORT_BENCH_FILTER = (
-    r"^(solve|isa)/(pairs|debris|pile|pile\+shuffle)/f32/"
+    r"^(solve|isa)/(pairs|debris|pile|pile\+shuffle|chain)/f32/"
     r"|^solve/(pairs|debris|pile)/f64/"
-    r"|^schedule/(pairs|debris|pile|pile\+shuffle)/f32/"
+    r"|^schedule/(pairs|debris|pile|pile\+shuffle|chain)/f32/"
     r"|^textbook/pairs/"
     r"|^model/(pairs|debris)/[a-z+]+/f32/simd/t:2/n:4194304"
     r"|^accurate/pairs/[a-z+]+/f32/simd/t:2/n:4194304"
@@ -983,6 +983,8 @@ def self_test() -> int:
         ("pairs rate", "| pairs | float | 4Mi |" in page and "| 120 |" in page),
         ("chain scene", "| chain | double | 64Ki |" in page),
         ("no pile scene", "pile" not in page),
+        ("short run has the chain", all(re.search(SHORT_BENCH_FILTER, name) for name in (
+            "solve/chain/f32/simd/t:2/n:4194304", "isa/chain/f32/auto/t:1/n:65536", "schedule/chain/f32/n:4194304"))),
         ("median aggregate", "| 26.0 |" in page and "| 27.0 |" not in page),
         ("simd / scalar", "4.0x" in page),
         ("accurate / fast", "| 0.50 |" in page),

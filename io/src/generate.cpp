@@ -1,4 +1,4 @@
-// generate.cpp - the random "pairs", "debris" and "pile" scenes.
+// generate.cpp - the random "pairs", "debris", "pile" and "chain" scenes.
 //
 // Design notes
 // ------------
@@ -28,6 +28,15 @@
 //   permutation of the indices (a Feistel network keyed by the seed,
 //   cycle-walked into [0, count)), moves contacts without changing them and
 //   contact k is still a pure function of (seed, side, k).
+// * The chain is a staircase of the pile's boxes with no ground: box k + 1
+//   is the +x (k even) or +y (k odd) lattice neighbour of box k, its boxes
+//   and contacts are drawn by the pile's code (draw_box, draw_face_contact),
+//   in streams of its own, so the two scenes share their margins and their
+//   tests' reasoning but no values. Instead of the pile's compression field,
+//   which closes n neighbours in a row only with speeds growing along it,
+//   the chain's boxes move at +-(0.5, -0.5, 0) m/s by parity: the staircase
+//   alternates x and y steps, so every neighbour pair closes at 1 m/s along
+//   its normal with speeds that do not grow with the chain.
 #include "collide/io/generate.hpp"
 
 #include <algorithm>
@@ -51,6 +60,8 @@ constexpr std::uint64_t kDebrisContactStream = 0x6465627269730003ULL;
 constexpr std::uint64_t kPileBodyStream = 0x70696c6500000004ULL;
 constexpr std::uint64_t kPileContactStream = 0x70696c6500000005ULL;
 constexpr std::uint64_t kPileShuffleStream = 0x70696c6500000006ULL;
+constexpr std::uint64_t kChainBodyStream = 0x636861696e000007ULL;
+constexpr std::uint64_t kChainContactStream = 0x636861696e000008ULL;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinApproachSpeed = 1e-2;  // [m/s]
@@ -184,6 +195,8 @@ void store_ground(Vec3 p, BodyRecord<double>& body) {
 // r x n holds the two face offsets), 0.6 m/s in all; the bottom layer falls
 // onto the ground at 1 m/s, less 0.1 + 0.2. So every contact approaches by
 // at least 0.4 m/s, far above float's rounding of speeds below 2000 m/s.
+// The chain's neighbours close at the same 1 m/s (chain_velocity) and take
+// the same jitter and spin, so the same margin holds for its contacts.
 constexpr double kPileCompression = 1.0;     // [1/s]
 constexpr double kPileVelocityJitter = 0.1;  // [m/s] per axis
 constexpr double kPileSpin = 0.25;           // [rad/s] per axis
@@ -204,8 +217,67 @@ Vec3 pile_box_centre(std::size_t side, std::uint64_t i) {
   return {static_cast<double>(ix) + 0.5, static_cast<double>(iy) + 0.5, static_cast<double>(iz) + 0.5};
 }
 
+/// The pile's compression field at p: towards `towards` at kPileCompression.
+Vec3 compression_velocity(Vec3 p, Vec3 towards) {
+  return {-kPileCompression * (p.x - towards.x), -kPileCompression * (p.y - towards.y),
+          -kPileCompression * (p.z - towards.z)};
+}
+
+/// A box of the pile or the chain: mass, edges and the moments of a solid
+/// box, a small tilt, centred at p, moving at `velocity` (the pile's
+/// compression field, the chain's parity velocity) plus a small jitter,
+/// spinning a little; fitted to the model after all of its draws.
+void draw_box(CounterRng& rng, Vec3 p, Vec3 velocity, Model model, BodyRecord<double>& body) {
+  body.m = rng.uniform(0.1, 20.0);
+  const Vec3 edge = uniform_vec(rng, kPileMinEdge, kPileMaxEdge);
+  // A solid box's principal moments about its centre, along its edges.
+  body.I[0] = body.m * (edge.y * edge.y + edge.z * edge.z) / 12.0;
+  body.I[1] = body.m * (edge.x * edge.x + edge.z * edge.z) / 12.0;
+  body.I[2] = body.m * (edge.x * edge.x + edge.y * edge.y) / 12.0;
+  store_rotation(uniform_vec(rng, -kPileTilt, kPileTilt), body.q);
+  store(p, body.p);
+  const Vec3 jitter = uniform_vec(rng, -kPileVelocityJitter, kPileVelocityJitter);
+  store(velocity + jitter, body.v);
+  store(uniform_vec(rng, -kPileSpin, kPileSpin), body.w);
+  fit_model(model, body);
+}
+
 /// Which body a pile contact joins to its box (side a).
 enum class PileNeighbour { x, y, z, ground };
+
+/// The point, normal, e and mu of the contact between the box centred at p
+/// (side a) and its neighbour on `face` (side b): the point on the touching
+/// face, offset within it along its two axes, the normal along the axis from
+/// b towards a. The caller sets a and b.
+void draw_face_contact(CounterRng& rng, Vec3 p, PileNeighbour face, bool friction, ContactRecord<double>& contact) {
+  // Offsets within the touching face, along its two axes.
+  const double t1 = rng.uniform(-kPileContactOffset, kPileContactOffset);
+  const double t2 = rng.uniform(-kPileContactOffset, kPileContactOffset);
+  Vec3 c{}, n{};
+  switch (face) {
+    case PileNeighbour::x:
+      c = {p.x + 0.5, p.y + t1, p.z + t2};
+      n = {-1.0, 0.0, 0.0};
+      break;
+    case PileNeighbour::y:
+      c = {p.x + t1, p.y + 0.5, p.z + t2};
+      n = {0.0, -1.0, 0.0};
+      break;
+    case PileNeighbour::z:
+      c = {p.x + t1, p.y + t2, p.z + 0.5};
+      n = {0.0, 0.0, -1.0};
+      break;
+    case PileNeighbour::ground:
+      c = {p.x + t1, p.y + t2, p.z - 0.5};
+      n = {0.0, 0.0, 1.0};
+      break;
+  }
+  store(c, contact.c);
+  store(n, contact.n);
+  contact.e = rng.uniform();
+  const double mu = rng.uniform();
+  contact.mu = friction ? mu : 0.0;
+}
 
 /// Contacts of one z layer: its +x and +y contacts, +z below the top layer,
 /// and the ground under the bottom one.
@@ -267,41 +339,26 @@ void draw_pile_contact_at(const GenerateOptions& options, std::size_t side, std:
   std::uint64_t box = 0;
   PileNeighbour neighbour = PileNeighbour::x;
   locate_pile_contact(side, q, box, neighbour);
-  CounterRng rng(options.seed, kPileContactStream, q);
-  // Offsets within the touching face, along its two axes.
-  const double t1 = rng.uniform(-kPileContactOffset, kPileContactOffset);
-  const double t2 = rng.uniform(-kPileContactOffset, kPileContactOffset);
-  const Vec3 p = pile_box_centre(side, box);
   const std::uint64_t s = side;
-  contact.a = static_cast<BodyIndex>(box);
-  Vec3 c{}, n{};
+  std::uint64_t other = 0;
   switch (neighbour) {
     case PileNeighbour::x:
-      contact.b = static_cast<BodyIndex>(box + 1);
-      c = {p.x + 0.5, p.y + t1, p.z + t2};
-      n = {-1.0, 0.0, 0.0};
+      other = box + 1;
       break;
     case PileNeighbour::y:
-      contact.b = static_cast<BodyIndex>(box + s);
-      c = {p.x + t1, p.y + 0.5, p.z + t2};
-      n = {0.0, -1.0, 0.0};
+      other = box + s;
       break;
     case PileNeighbour::z:
-      contact.b = static_cast<BodyIndex>(box + s * s);
-      c = {p.x + t1, p.y + t2, p.z + 0.5};
-      n = {0.0, 0.0, -1.0};
+      other = box + s * s;
       break;
     case PileNeighbour::ground:
-      contact.b = static_cast<BodyIndex>(s * s * s);
-      c = {p.x + t1, p.y + t2, p.z - 0.5};
-      n = {0.0, 0.0, 1.0};
+      other = s * s * s;
       break;
   }
-  store(c, contact.c);
-  store(n, contact.n);
-  contact.e = rng.uniform();
-  const double mu = rng.uniform();
-  contact.mu = options.friction ? mu : 0.0;
+  contact.a = static_cast<BodyIndex>(box);
+  contact.b = static_cast<BodyIndex>(other);
+  CounterRng rng(options.seed, kPileContactStream, q);
+  draw_face_contact(rng, pile_box_centre(side, box), neighbour, options.friction, contact);
 }
 
 /// A bijection of [0, count) drawn from the seed: a Feistel network on the
@@ -343,6 +400,42 @@ class IndexPermutation {
   std::uint64_t mask_ = 1;
   std::uint64_t keys_[kRounds] = {};
 };
+
+// -- the chain ---------------------------------------------------------------
+
+/// The centre of box i of the chain: its lattice cell is ((i + 1) / 2, i / 2,
+/// 0), so box i + 1 is box i's +x neighbour for even i and its +y neighbour
+/// for odd i (the cells' x + y is i: boxes two or more apart in the chain
+/// meet at most along an edge, never on a face).
+Vec3 chain_box_centre(std::uint64_t i) {
+  return {static_cast<double>((i + 1) / 2) + 0.5, static_cast<double>(i / 2) + 0.5, 0.5};
+}
+
+/// Which neighbour of box k the chain's next box is, and so which of the
+/// pile's face contacts contact k is: +x for even k, +y for odd k.
+PileNeighbour chain_step(std::uint64_t k) { return k % 2 == 0 ? PileNeighbour::x : PileNeighbour::y; }
+
+/// A chain box's speed along x and along y before its jitter [m/s]:
+/// neighbours move opposite ways, so they close at 2 x 0.5 = 1 m/s, the
+/// pile's closing speed.
+constexpr double kChainSpeed = 0.5;
+
+/// The velocity of box i of the chain before its jitter: (0.5, -0.5, 0) for
+/// even i, its opposite for odd i. Neighbours have opposite parities, so
+/// along the axis of their step (x after an even box, y after an odd one)
+/// each moves towards the other and the pair closes at 1 m/s; across it they
+/// slide past each other, which the normal does not see.
+Vec3 chain_velocity(std::uint64_t i) {
+  const double s = i % 2 == 0 ? kChainSpeed : -kChainSpeed;
+  return {s, -s, 0.0};
+}
+
+void check_chain_contacts(std::size_t contacts) {
+  if (contacts > kMaxChainContacts) {
+    throw std::invalid_argument("generate_chain: " + std::to_string(contacts) + " contacts, at most " +
+                                std::to_string(kMaxChainContacts) + " (body ids are 32-bit)");
+  }
+}
 
 void check_pile_side(std::size_t side) {
   if (side > kMaxPileSide) {
@@ -446,28 +539,30 @@ void draw_pile_body(const GenerateOptions& options, std::size_t side, std::uint6
     return;
   }
   CounterRng rng(options.seed, kPileBodyStream, i);
-  body.m = rng.uniform(0.1, 20.0);
-  const Vec3 edge = uniform_vec(rng, kPileMinEdge, kPileMaxEdge);
-  // A solid box's principal moments about its centre, along its edges.
-  body.I[0] = body.m * (edge.y * edge.y + edge.z * edge.z) / 12.0;
-  body.I[1] = body.m * (edge.x * edge.x + edge.z * edge.z) / 12.0;
-  body.I[2] = body.m * (edge.x * edge.x + edge.y * edge.y) / 12.0;
-  store_rotation(uniform_vec(rng, -kPileTilt, kPileTilt), body.q);
   const Vec3 p = pile_box_centre(side, i);
-  store(p, body.p);
-  const Vec3 centre = pile_centre(side);
-  const Vec3 jitter = uniform_vec(rng, -kPileVelocityJitter, kPileVelocityJitter);
-  const Vec3 v{-kPileCompression * (p.x - centre.x) + jitter.x, -kPileCompression * (p.y - centre.y) + jitter.y,
-               -kPileCompression * (p.z - centre.z) + jitter.z};
-  store(v, body.v);
-  store(uniform_vec(rng, -kPileSpin, kPileSpin), body.w);
-  fit_model(options.model, body);
+  draw_box(rng, p, compression_velocity(p, pile_centre(side)), options.model, body);
 }
 
 void draw_pile_contact(const GenerateOptions& options, std::size_t side, std::uint64_t k,
                        ContactRecord<double>& contact) {
   const std::uint64_t q = options.shuffle ? IndexPermutation(options.seed, pile_contact_count(side))(k) : k;
   draw_pile_contact_at(options, side, q, contact);
+}
+
+std::size_t chain_body_count(std::size_t contacts) { return contacts + 1; }
+
+void draw_chain_body(const GenerateOptions& options, std::size_t /*contacts*/, std::uint64_t i,
+                     BodyRecord<double>& body) {
+  CounterRng rng(options.seed, kChainBodyStream, i);
+  draw_box(rng, chain_box_centre(i), chain_velocity(i), options.model, body);
+}
+
+void draw_chain_contact(const GenerateOptions& options, std::size_t /*contacts*/, std::uint64_t k,
+                        ContactRecord<double>& contact) {
+  contact.a = static_cast<BodyIndex>(k);
+  contact.b = static_cast<BodyIndex>(k + 1);
+  CounterRng rng(options.seed, kChainContactStream, k);
+  draw_face_contact(rng, chain_box_centre(k), chain_step(k), options.friction, contact);
 }
 
 template <class T>
@@ -544,11 +639,22 @@ Scene<T> generate_pile(std::size_t side, const GenerateOptions& options) {
       });
 }
 
+template <class T>
+Scene<T> generate_chain(std::size_t contacts, const GenerateOptions& options) {
+  check_chain_contacts(contacts);
+  return draw_scene<T>(
+      chain_body_count(contacts), contacts,
+      [&](std::size_t i, BodyRecord<double>& body) { draw_chain_body(options, contacts, i, body); },
+      [&](std::size_t k, ContactRecord<double>& c) { draw_chain_contact(options, contacts, k, c); });
+}
+
 template Scene<float> generate_pairs<float>(std::size_t, const GenerateOptions&);
 template Scene<double> generate_pairs<double>(std::size_t, const GenerateOptions&);
 template Scene<float> generate_debris<float>(std::size_t, const GenerateOptions&);
 template Scene<double> generate_debris<double>(std::size_t, const GenerateOptions&);
 template Scene<float> generate_pile<float>(std::size_t, const GenerateOptions&);
 template Scene<double> generate_pile<double>(std::size_t, const GenerateOptions&);
+template Scene<float> generate_chain<float>(std::size_t, const GenerateOptions&);
+template Scene<double> generate_chain<double>(std::size_t, const GenerateOptions&);
 
 }  // namespace collide

@@ -6,13 +6,20 @@
 // b of every fourth contact; the pile is its lattice (every contact between
 // lattice neighbours or a bottom box and the ground, each touching pair
 // once, in broadphase cell order or a permutation of it, points off the
-// line of centres); the inputs are valid scene values.
+// line of centres); the chain is its staircase (box k + 1 the +x or +y
+// neighbour of box k by parity, contact k between boxes k and k + 1, no
+// ground, one schedule batch per contact, speeds bounded whatever its
+// length); the inputs are valid scene values.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -21,13 +28,15 @@
 
 #include "collide/io/generate.hpp"
 #include "collide/model.hpp"
+#include "collide/schedule.hpp"
 
 namespace {
 
-template <class T>
-T approach_speed(const collide::Scene<T>& scene, std::size_t k) {
-  const auto b = scene.bodies.view();
-  const auto c = scene.contacts.view();
+/// u . n of contact k, from the views of a scene's bodies and contacts (taken
+/// once: a contact view scans mu).
+template <class BodyView, class ContactView>
+auto approach_speed(const BodyView& b, const ContactView& c, std::size_t k) {
+  using T = std::remove_cvref_t<decltype(b.p.x[0])>;
   const std::size_t ia = c.a[k], ib = c.b[k];
   const T ra[3] = {c.c.x[k] - b.p.x[ia], c.c.y[k] - b.p.y[ia], c.c.z[k] - b.p.z[ia]};
   const T rb[3] = {c.c.x[k] - b.p.x[ib], c.c.y[k] - b.p.y[ib], c.c.z[k] - b.p.z[ib]};
@@ -39,7 +48,7 @@ T approach_speed(const collide::Scene<T>& scene, std::size_t k) {
   T ua[3], ub[3];
   point_velocity(ia, ra, ua);
   point_velocity(ib, rb, ub);
-  return (ua[0] - ub[0]) * c.n.x[k] + (ua[1] - ub[1]) * c.n.y[k] + (ua[2] - ub[2]) * c.n.z[k];
+  return T((ua[0] - ub[0]) * c.n.x[k] + (ua[1] - ub[1]) * c.n.y[k] + (ua[2] - ub[2]) * c.n.z[k]);
 }
 
 /// u . n of one contact between two body records, in T.
@@ -68,7 +77,7 @@ void expect_valid_and_approaching(const collide::Scene<T>& scene) {
     ASSERT_NE(c.a[k], c.b[k]);
     ASSERT_LT(c.a[k], b.count);
     ASSERT_LT(c.b[k], b.count);
-    ASSERT_LT(approach_speed(scene, k), T(0)) << "contact " << k;
+    ASSERT_LT(approach_speed(b, c, k), T(0)) << "contact " << k;
     ASSERT_TRUE(c.e[k] >= 0 && c.e[k] <= 1);
   }
 }
@@ -502,6 +511,360 @@ TEST(PileScene, SizesAndLimits) {
   EXPECT_EQ(empty.bodies.view().inv_mass[0], 0.0);
   expect_valid_and_approaching(collide::generate_pile<double>(1));
   expect_valid_and_approaching(collide::generate_pile<float>(2));
+}
+
+// ---------------------------------------------------------------------------
+// The chain.
+// ---------------------------------------------------------------------------
+
+/// A body record widened to double, value by value (exact).
+template <class T>
+collide::BodyRecord<double> widen(const collide::BodyRecord<T>& r) {
+  collide::BodyRecord<double> o;
+  o.m = r.m;
+  for (int j = 0; j < 3; ++j) {
+    o.I[j] = r.I[j];
+    o.p[j] = r.p[j];
+    o.v[j] = r.v[j];
+    o.w[j] = r.w[j];
+  }
+  for (int j = 0; j < 4; ++j) o.q[j] = r.q[j];
+  return o;
+}
+
+template <class T>
+collide::ContactRecord<double> widen(const collide::ContactRecord<T>& r) {
+  collide::ContactRecord<double> o;
+  o.a = r.a;
+  o.b = r.b;
+  for (int j = 0; j < 3; ++j) {
+    o.c[j] = r.c[j];
+    o.n[j] = r.n[j];
+  }
+  o.e = r.e;
+  o.mu = r.mu;
+  return o;
+}
+
+/// Every contact of a scene approaches by more than `margin`, u . n computed
+/// in double from the stored bodies and contacts (a float scene widened
+/// exactly), with the pile's helper.
+template <class T>
+void expect_approaching_in_double(const collide::Scene<T>& scene, double margin) {
+  const collide::Scene<double> wide = collide::convert_scene<double>(scene);
+  const auto b = wide.bodies.view();
+  const auto c = wide.contacts.view();
+  for (std::size_t k = 0; k < c.count; ++k) {
+    ASSERT_LT(approach_speed(b, c, k), -margin) << "contact " << k;
+  }
+}
+
+/// The centre of box i of the chain before its draws: cell ((i + 1) / 2,
+/// i / 2, 0) + 0.5, written out here so the test does not share the code.
+std::array<double, 3> staircase_centre(std::uint64_t i) {
+  return {static_cast<double>((i + 1) / 2) + 0.5, static_cast<double>(i / 2) + 0.5, 0.5};
+}
+
+/// The velocity of box i before its jitter: (0.5, -0.5, 0) for even i, its
+/// opposite for odd i.
+std::array<double, 3> staircase_velocity(std::uint64_t i) {
+  const double s = i % 2 == 0 ? 0.5 : -0.5;
+  return {s, -s, 0.0};
+}
+
+TEST(ChainScene, CountsOrderAndStaircase) {
+  for (const std::size_t n : {0U, 1U, 2U, 3U, 7U, 1000U}) {
+    SCOPED_TRACE(n);
+    const auto scene = collide::generate_chain<double>(n, {3, true});
+    ASSERT_EQ(scene.bodies.size(), n + 1);
+    ASSERT_EQ(collide::chain_body_count(n), n + 1);
+    ASSERT_EQ(scene.contacts.size(), n);
+    const auto b = scene.bodies.view();
+    const auto c = scene.contacts.view();
+    // No ground: every box is movable, on its cell of the staircase.
+    std::map<std::pair<std::int64_t, std::int64_t>, std::size_t> cell_of_box;
+    for (std::size_t i = 0; i < b.count; ++i) {
+      SCOPED_TRACE(i);
+      ASSERT_GT(b.inv_mass[i], 0.0);
+      const auto p = staircase_centre(i);
+      ASSERT_EQ(b.p.x[i], p[0]);
+      ASSERT_EQ(b.p.y[i], p[1]);
+      ASSERT_EQ(b.p.z[i], p[2]);
+      // Box i + 1 is box i's +x neighbour for even i, its +y one for odd i.
+      if (i + 1 < b.count) {
+        ASSERT_EQ(b.p.x[i + 1] - b.p.x[i], i % 2 == 0 ? 1.0 : 0.0);
+        ASSERT_EQ(b.p.y[i + 1] - b.p.y[i], i % 2 == 0 ? 0.0 : 1.0);
+        ASSERT_EQ(b.p.z[i + 1], b.p.z[i]);
+      }
+      const auto cell = std::make_pair(static_cast<std::int64_t>(std::floor(b.p.x[i])),
+                                       static_cast<std::int64_t>(std::floor(b.p.y[i])));
+      ASSERT_TRUE(cell_of_box.emplace(cell, i).second) << "two boxes in one cell";
+    }
+    // Only consecutive boxes share a face (the staircase lies in one layer, so
+    // the faces that can touch are along x and y).
+    for (const auto& [cell, i] : cell_of_box) {
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        const auto it = cell_of_box.find({cell.first + dx, cell.second + dy});
+        if (it != cell_of_box.end()) {
+          ASSERT_EQ(std::max(i, it->second) - std::min(i, it->second), 1U) << "boxes " << i << ", " << it->second;
+        }
+      }
+    }
+    for (std::size_t k = 0; k < c.count; ++k) {
+      SCOPED_TRACE(k);
+      ASSERT_EQ(c.a[k], k);
+      ASSERT_EQ(c.b[k], k + 1);
+      // The pile's +x (even k) or +y (odd k) contact of box k: the normal from
+      // b towards a, the point on the plane between the centres, off the line
+      // of centres within the face.
+      const bool along_x = k % 2 == 0;
+      EXPECT_EQ(c.n.x[k], along_x ? -1.0 : 0.0);
+      EXPECT_EQ(c.n.y[k], along_x ? 0.0 : -1.0);
+      EXPECT_EQ(c.n.z[k], 0.0);
+      const double r[3] = {c.c.x[k] - b.p.x[k], c.c.y[k] - b.p.y[k], c.c.z[k] - b.p.z[k]};
+      const int normal_axis = along_x ? 0 : 1;
+      const int face_axis = along_x ? 1 : 0;
+      EXPECT_EQ(r[normal_axis], 0.5);
+      EXPECT_LE(std::fabs(r[face_axis]), 0.4 + 1e-12);
+      EXPECT_LE(std::fabs(r[2]), 0.4 + 1e-12);
+      EXPECT_GT(std::hypot(r[face_axis], r[2]), 0.0) << "a contact point on the line of centres";
+      EXPECT_TRUE(c.e[k] >= 0 && c.e[k] < 1);
+      EXPECT_TRUE(c.mu[k] >= 0 && c.mu[k] < 1);
+    }
+  }
+}
+
+TEST(ChainScene, BoxesAreThePilesBoxesAtBoundedSpeeds) {
+  const auto scene = collide::generate_chain<double>(200, {8, false});
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const auto r = scene.bodies.record(i);
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(r.m >= 0.1 && r.m < 20.0001);
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_GT(r.I[j] / r.m, 2 * 0.81 / 12 * 0.9999);
+      EXPECT_LT(r.I[j] / r.m, 2.0 / 12 * 1.0001);
+      EXPECT_LT(r.I[j], r.I[(j + 1) % 3] + r.I[(j + 2) % 3]);
+    }
+    EXPECT_LT(2 * std::acos(std::min(1.0, r.q[0])), 0.0867);
+    // (0.5, -0.5, 0) m/s for even boxes, the opposite for odd ones, plus up
+    // to 0.1 m/s per axis; spinning at up to 0.25 rad/s per axis.
+    const auto v = staircase_velocity(i);
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_LE(std::fabs(r.v[j] - v[j]), 0.1) << j;
+      EXPECT_LE(std::fabs(r.w[j]), 0.25) << j;
+    }
+  }
+}
+
+TEST(ChainScene, EveryContactApproachesAtBoundedSpeeds) {
+  for (const collide::Model model : {collide::Model::rigid, collide::Model::sphere, collide::Model::particle}) {
+    for (const bool friction : {false, true}) {
+      SCOPED_TRACE(collide::to_string(model));
+      for (const std::size_t n : {1U, 2U, 3U, 3000U}) {
+        SCOPED_TRACE(n);
+        const collide::GenerateOptions o{11, friction, model};
+        expect_valid_and_approaching(collide::generate_chain<double>(n, o));
+        expect_valid_and_approaching(collide::generate_chain<float>(n, o));
+        // The documented 0.4 m/s margin, from the stored values in double.
+        expect_approaching_in_double(collide::generate_chain<double>(n, o), 0.4);
+        expect_approaching_in_double(collide::generate_chain<float>(n, o), 0.4);
+      }
+    }
+  }
+  // A long chain in float, 2^20 contacts: the speeds do not grow along it, so
+  // every contact keeps the margin (float rounds the contact points of the
+  // far boxes to a 16th of a metre, which could cost 0.016 m/s; they keep
+  // more than 0.5 m/s), and every speed stays within 0.6 m/s per axis.
+  {
+    const auto f = collide::generate_chain<float>(std::size_t{1} << 20, {2, false});
+    expect_valid_and_approaching(f);
+    expect_approaching_in_double(f, 0.4);
+    const auto b = f.bodies.view();
+    float fastest = 0;
+    for (std::size_t i = 0; i < b.count; ++i) {
+      fastest = std::max({fastest, std::fabs(b.v.x[i]), std::fabs(b.v.y[i]), std::fabs(b.v.z[i])});
+    }
+    EXPECT_LE(fastest, 0.6F);
+    EXPECT_GT(fastest, 0.59F);
+    EXPECT_EQ(b.p.x[b.count - 1], 524288.5F);  // the last box, 2^20, in cell (2^19, 2^19)
+    EXPECT_EQ(b.p.y[b.count - 1], 524288.5F);
+  }
+  // The benchmark's largest chain, 4Mi contacts, and the tail of the longest
+  // chain there may be, drawn item by item: in double (and for the 4Mi, in
+  // float too) every contact approaches by 0.4 m/s, at speeds within 0.6 m/s.
+  const collide::GenerateOptions o{2, false};
+  const auto check = [&](std::size_t n, std::uint64_t from, bool in_float) {
+    SCOPED_TRACE(n);
+    double fastest = 0;
+    for (std::uint64_t k = from; k < n; ++k) {
+      collide::ContactRecord<double> c;
+      collide::BodyRecord<double> a, b;
+      collide::draw_chain_contact(o, n, k, c);
+      collide::draw_chain_body(o, n, c.a, a);
+      collide::draw_chain_body(o, n, c.b, b);
+      ASSERT_LT(record_approach_speed(a, b, c), -0.4) << k;
+      if (in_float) {
+        const auto af = widen(collide::detail::narrow<float>(a));
+        const auto bf = widen(collide::detail::narrow<float>(b));
+        const auto cf = widen(collide::detail::narrow<float>(c));
+        ASSERT_LT(record_approach_speed(af, bf, cf), -0.4) << k;
+      }
+      for (int j = 0; j < 3; ++j) fastest = std::max({fastest, std::fabs(a.v[j]), std::fabs(b.v[j])});
+      // The staircase holds at any length.
+      const auto pa = staircase_centre(k);
+      ASSERT_EQ(a.p[0], pa[0]) << k;
+      ASSERT_EQ(a.p[1], pa[1]) << k;
+      ASSERT_EQ(b.p[0] - a.p[0], k % 2 == 0 ? 1.0 : 0.0) << k;
+      ASSERT_EQ(b.p[1] - a.p[1], k % 2 == 0 ? 0.0 : 1.0) << k;
+    }
+    EXPECT_LE(fastest, 0.6);
+    EXPECT_LE(fastest, 1.0);
+  };
+  check(std::size_t{1} << 22, 0, true);
+  check(collide::kMaxChainContacts, collide::kMaxChainContacts - 100000, false);
+}
+
+TEST(ChainScene, PureFunctionOfSeedAndK) {
+  const collide::GenerateOptions o{21, true};
+  const std::size_t n = 20000;  // several blocks of work
+  const auto first = collide::generate_chain<double>(n, o);
+  EXPECT_TRUE(same_bits(first, collide::generate_chain<double>(n, o)));
+  {
+    oneapi::tbb::global_control one(oneapi::tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_TRUE(same_bits(first, collide::generate_chain<double>(n, o))) << "one thread";
+  }
+  // The streaming pieces are the scene's items.
+  for (const std::uint64_t i : {0u, 1u, 9999u, 20000u}) {
+    collide::BodyRecord<double> body;
+    collide::draw_chain_body(o, n, i, body);
+    EXPECT_EQ(first.bodies.view().v.x[i], body.v[0]) << i;
+    EXPECT_EQ(first.bodies.view().q.z[i], body.q[3]) << i;
+    EXPECT_EQ(first.bodies.view().inv_mass[i], 1.0 / body.m) << i;
+  }
+  for (const std::uint64_t k : {0u, 5u, 12345u, 19999u}) {
+    collide::ContactRecord<double> contact;
+    collide::draw_chain_contact(o, n, k, contact);
+    const auto got = first.contacts.record(k);
+    EXPECT_EQ(got.a, contact.a);
+    EXPECT_EQ(got.b, contact.b);
+    EXPECT_EQ(got.c[1], contact.c[1]);
+    EXPECT_EQ(got.c[2], contact.c[2]);
+    EXPECT_EQ(got.e, contact.e);
+    EXPECT_EQ(got.mu, contact.mu);
+  }
+  // Neither a contact nor a box depends on the chain's length.
+  const auto shorter = collide::generate_chain<double>(100, o);
+  EXPECT_EQ(shorter.contacts.record(77).c[1], first.contacts.record(77).c[1]);
+  EXPECT_EQ(shorter.contacts.record(77).e, first.contacts.record(77).e);
+  EXPECT_EQ(shorter.bodies.record(77).v[0], first.bodies.record(77).v[0]);
+  EXPECT_EQ(shorter.bodies.record(78).p[1], first.bodies.record(78).p[1]);
+  // Another seed, another chain; friction changes mu only.
+  const auto other = collide::generate_chain<double>(n, {22, true});
+  EXPECT_NE(other.contacts.record(0).c[1], first.contacts.record(0).c[1]);
+  EXPECT_NE(other.bodies.record(0).m, first.bodies.record(0).m);
+  const auto frictionless = collide::generate_chain<double>(n, {21, false});
+  for (std::size_t k = 0; k < 100; ++k) {
+    EXPECT_EQ(frictionless.contacts.record(k).mu, 0.0);
+    EXPECT_GT(first.contacts.record(k).mu, 0.0);
+    EXPECT_EQ(frictionless.contacts.record(k).e, first.contacts.record(k).e);
+    EXPECT_EQ(frictionless.bodies.record(k).v[0], first.bodies.record(k).v[0]);
+  }
+  // Not the pile's values: the chain draws from streams of its own.
+  const auto pile = collide::generate_pile<double>(2, o);
+  EXPECT_NE(pile.bodies.record(0).m, first.bodies.record(0).m);
+  EXPECT_NE(pile.contacts.record(0).c[1], first.contacts.record(0).c[1]);
+}
+
+TEST(ChainScene, FloatAndDoubleAgreeWithinRounding) {
+  const collide::GenerateOptions o{6, true};
+  const std::size_t n = 5000;
+  const auto f = collide::generate_chain<float>(n, o);
+  const auto d = collide::generate_chain<double>(n, o);
+  // The float scene is the double one, each value rounded once.
+  const auto fb = f.bodies.view();
+  const auto db = d.bodies.view();
+  ASSERT_EQ(fb.count, db.count);
+  const auto near = [](double x, double y) { return std::fabs(x - y) <= 0x1p-24 * std::fabs(y); };
+  for (std::size_t i = 0; i < fb.count; ++i) {
+    SCOPED_TRACE(i);
+    ASSERT_EQ(fb.p.x[i], static_cast<float>(db.p.x[i]));
+    ASSERT_EQ(fb.v.x[i], static_cast<float>(db.v.x[i]));
+    ASSERT_EQ(fb.w.y[i], static_cast<float>(db.w.y[i]));
+    ASSERT_EQ(fb.q.w[i], static_cast<float>(db.q.w[i]));
+    ASSERT_TRUE(near(fb.v.z[i], db.v.z[i]));
+    // Inverse mass and moments are the rounded draws' inverses, within a float rounding or two.
+    ASSERT_NEAR(fb.inv_mass[i], db.inv_mass[i], 2 * 0x1p-24 * db.inv_mass[i]);
+    ASSERT_NEAR(fb.inv_inertia.z[i], db.inv_inertia.z[i], 2 * 0x1p-24 * db.inv_inertia.z[i]);
+  }
+  const auto fc = f.contacts.view();
+  const auto dc = d.contacts.view();
+  ASSERT_EQ(fc.count, dc.count);
+  for (std::size_t k = 0; k < fc.count; ++k) {
+    SCOPED_TRACE(k);
+    ASSERT_EQ(fc.a[k], dc.a[k]);
+    ASSERT_EQ(fc.b[k], dc.b[k]);
+    ASSERT_EQ(fc.c.y[k], static_cast<float>(dc.c.y[k]));
+    ASSERT_EQ(fc.n.x[k], static_cast<float>(dc.n.x[k]));
+    ASSERT_EQ(fc.e[k], static_cast<float>(dc.e[k]));
+    ASSERT_EQ(fc.mu[k], static_cast<float>(dc.mu[k]));
+    ASSERT_TRUE(near(fc.c.z[k], dc.c.z[k]));
+  }
+}
+
+TEST(ChainScene, FitsEachModel) {
+  auto rigid = collide::generate_chain<double>(500, {4, false});
+  const auto b = rigid.bodies.view();
+  const auto c = rigid.contacts.view();
+  EXPECT_EQ(collide::choose_model(b, c), collide::Model::rigid);
+  EXPECT_FALSE(collide::model_misfit(collide::Model::sphere, b, c).empty());
+  EXPECT_FALSE(collide::model_misfit(collide::Model::particle, b, c).empty());
+  for (const collide::Model model : {collide::Model::rigid, collide::Model::sphere, collide::Model::particle}) {
+    for (const bool friction : {false, true}) {
+      auto d = collide::generate_chain<double>(500, {4, friction, model});
+      EXPECT_EQ(collide::model_misfit(model, d.bodies.view(), d.contacts.view()), "") << collide::to_string(model);
+      auto f = collide::generate_chain<float>(500, {4, friction, model});
+      EXPECT_EQ(collide::model_misfit(model, f.bodies.view(), f.contacts.view()), "") << collide::to_string(model);
+      EXPECT_EQ(collide::choose_model(f.bodies.view(), f.contacts.view()), model) << collide::to_string(model);
+    }
+  }
+}
+
+TEST(ChainScene, ScheduleIsOneBatchPerContact) {
+  auto d = collide::generate_chain<double>(1000, {7, true});
+  collide::Schedule schedule;
+  schedule.build(d.contacts.view(), d.bodies.view());
+  EXPECT_EQ(schedule.contact_count(), 1000U);
+  EXPECT_EQ(schedule.batch_count(), 1000U);
+  EXPECT_EQ(schedule.largest_batch(), 1U);
+  // Batch k is contact k: the law runs through the staircase in chain order.
+  for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
+    ASSERT_EQ(schedule.batch_begin(k), k);
+    ASSERT_EQ(schedule.order()[k], k);
+  }
+  auto f = collide::generate_chain<float>(1000, {7, false, collide::Model::particle});
+  collide::Schedule float_schedule;
+  float_schedule.build(f.contacts.view(), f.bodies.view(), 2);
+  EXPECT_EQ(float_schedule.batch_count(), 1000U);
+}
+
+TEST(ChainScene, SizesAndLimits) {
+  EXPECT_EQ(collide::chain_body_count(0), 1U);
+  EXPECT_EQ(collide::chain_body_count(4194304), 4194305U);
+  // The longest chain's ids fit 32 bits, and so do its last contact's.
+  EXPECT_EQ(collide::kMaxChainContacts, std::size_t{0xFFFFFFFE});
+  EXPECT_LE(collide::chain_body_count(collide::kMaxChainContacts) - 1, std::size_t{0xFFFFFFFF});
+  collide::ContactRecord<double> last;
+  collide::draw_chain_contact({}, collide::kMaxChainContacts, collide::kMaxChainContacts - 1, last);
+  EXPECT_EQ(last.a, 0xFFFFFFFDU);
+  EXPECT_EQ(last.b, 0xFFFFFFFEU);
+  EXPECT_THROW(collide::generate_chain<float>(collide::kMaxChainContacts + 1), std::invalid_argument);
+  EXPECT_THROW(collide::generate_chain<double>(std::size_t{1} << 40), std::invalid_argument);
+  const auto empty = collide::generate_chain<double>(0);
+  EXPECT_EQ(empty.bodies.size(), 1U);
+  EXPECT_EQ(empty.contacts.size(), 0U);
+  EXPECT_GT(empty.bodies.view().inv_mass[0], 0.0);
+  expect_valid_and_approaching(collide::generate_chain<double>(1));
+  expect_valid_and_approaching(collide::generate_chain<float>(2));
 }
 
 }  // namespace

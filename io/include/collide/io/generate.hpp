@@ -1,8 +1,10 @@
 // collide/io/generate.hpp - random scenes for tests, benchmarks and `collide gen`.
 //
-// Three scenes: "pairs" (independent pairs), "debris" (contacts between
-// bodies picked at random, a ground body among them) and "pile" (boxes on a
-// lattice, each touching its neighbours, the bottom layer on the ground).
+// Four scenes: "pairs" (independent pairs), "debris" (contacts between
+// bodies picked at random, a ground body among them), "pile" (boxes on a
+// lattice, each touching its neighbours, the bottom layer on the ground) and
+// "chain" (boxes in a staircase, each touching the next, no ground: every
+// contact depends on the one before).
 // Draws follow the source page's test program: random masses, principal
 // moments, orientations (a rotation vector), velocities, contact offsets and
 // unit normals, re-drawn until the pair approaches. Every item is a pure
@@ -31,7 +33,8 @@ struct GenerateOptions {
   Model model = Model::rigid;
   /// The pile scene only: its contacts in a random order (a permutation drawn
   /// from the seed) instead of broadphase cell order; every contact's values
-  /// are the same. The pairs and debris contacts have no spatial order.
+  /// are the same. The pairs and debris contacts have no spatial order; the
+  /// chain keeps its chain order.
   bool shuffle = false;
 };
 
@@ -112,5 +115,58 @@ void draw_pile_body(const GenerateOptions& options, std::size_t side, std::uint6
 /// approaching in the initial state.
 void draw_pile_contact(const GenerateOptions& options, std::size_t side, std::uint64_t k,
                        ContactRecord<double>& contact);
+
+/// The "chain" scene: contacts + 1 boxes in a staircase on the pile's
+/// lattice (pitch 1 m), and no ground: every body is movable. Box i sits in
+/// cell ((i + 1) / 2, i / 2, 0), centred at the cell + 0.5 in each axis, so
+/// box i + 1 is the +x neighbour of box i for even i and its +y neighbour for
+/// odd i: cells (0, 0), (1, 0), (1, 1), (2, 1), (2, 2), ... Boxes two or more
+/// apart in the chain meet only diagonally, never on a face. Contact k joins
+/// box k (side a) and box k + 1 (side b), in chain order, drawn as the pile's
+/// +x (k even) or +y (k odd) contact of box k: on the plane between the two
+/// centres, offset within the touching face by up to 0.4 m along each face
+/// axis (off the line of centres, so the rigid model is needed), the normal
+/// from b towards a, (-1, 0, 0) or (0, -1, 0). Each box but the ends is in
+/// two contacts, so the level schedule (collide/schedule.hpp) makes one batch
+/// per contact and the law runs sequentially through every contact: a
+/// stand-in for a rope, a column or a stack, the scene with the longest
+/// dependency chain there is, against the pairs scene's none.
+///
+/// Boxes are drawn as the pile's are (mass, edges, moments, tilt, velocity
+/// jitter and spin: generate_pile) but for their velocity: even boxes move at
+/// (0.5, -0.5, 0) m/s and odd ones at (-0.5, 0.5, 0) m/s, plus up to 0.1 m/s
+/// per axis, so no speed exceeds 0.6 m/s per axis whatever the chain's
+/// length. Neighbours have opposite parities: along the axis of their step
+/// they close at 1 m/s, as the pile's neighbours do, and the pile's jitter
+/// and spin take at most 0.6 m/s of that (2 x 0.1 m/s of jitter, 2 x 0.2 m/s
+/// of spin times face offset): every contact approaches by at least 0.4 m/s
+/// in double, whatever the chain's length. Float
+/// rounds the velocities by less than 1e-7 m/s; it rounds the positions,
+/// which reach contacts/2 m along x and y, to an ulp of the coordinate, and
+/// a contact point moved within its face costs the margin up to a quarter of
+/// that ulp: in float every contact approaches by at least 0.38 m/s up to
+/// 2^20 contacts, 0.33 m/s up to 2^22 (the benchmark's largest chain) and
+/// 0.27 m/s up to 2^23; from about 2^24 contacts on, float no longer holds
+/// the box centres exactly. e and mu are drawn as the pile draws them; options.shuffle does
+/// not apply. At most kMaxChainContacts contacts (body ids are 32-bit);
+/// std::invalid_argument beyond.
+template <class T>
+Scene<T> generate_chain(std::size_t contacts, const GenerateOptions& options = {});
+
+/// The longest chain: contacts + 1 boxes have 32-bit ids (2^32 - 2 contacts,
+/// the most a Schedule takes).
+inline constexpr std::size_t kMaxChainContacts = (std::size_t{1} << 32) - 2;
+
+// The pieces of the chain scene, each a pure function of its arguments, so
+// that a chain can be written in a stream.
+
+/// Number of bodies of a chain of `contacts` contacts: contacts + 1 boxes.
+std::size_t chain_body_count(std::size_t contacts);
+/// Body i of the chain of `contacts` contacts (box i, i < contacts + 1).
+void draw_chain_body(const GenerateOptions& options, std::size_t contacts, std::uint64_t i, BodyRecord<double>& body);
+/// Contact k of the chain (between boxes k and k + 1), approaching in the
+/// initial state.
+void draw_chain_contact(const GenerateOptions& options, std::size_t contacts, std::uint64_t k,
+                        ContactRecord<double>& contact);
 
 }  // namespace collide
