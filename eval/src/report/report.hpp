@@ -149,7 +149,8 @@ struct Report {
 };
 
 // ---------------------------------------------------------------------------
-// The run (src/report/run_report.cpp).
+// The run (src/report/run_report.cpp; its scenes in report_scenes.cpp, the
+// machine block in report_machine.cpp).
 // ---------------------------------------------------------------------------
 
 /// What to measure; the defaults are `collide report` without options.

@@ -1,7 +1,9 @@
 // report/run_report.cpp - the engine of `collide report` (and of
 // collide.report() in Python): speed against error for every variant, on the
 // pairs, the debris and the pile scene. The shells print and write what it
-// returns.
+// returns. This file holds the Runner, which measures the rows, and the
+// entry points; the scenes come from report_scenes.cpp, the machine block
+// from report_machine.cpp.
 //
 // Design notes
 // ------------
@@ -56,7 +58,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -68,14 +69,11 @@
 #include <utility>
 #include <vector>
 
-#include "collide/eval/bandwidth.hpp"
 #include "collide/eval/error_bound.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/eval/traffic.hpp"
 #include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
-#include "collide/io/scene_io.hpp"
-#include "collide/io/scene_npz.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/rules.hpp"
@@ -83,6 +81,7 @@
 #include "collide/solve.hpp"
 #include "measure.hpp"
 #include "report.hpp"
+#include "report_run.hpp"
 
 namespace collide {
 
@@ -129,102 +128,8 @@ class Progress {
 };
 
 // ---------------------------------------------------------------------------
-// Scenes.
+// Timed runs.
 // ---------------------------------------------------------------------------
-
-/// Contacts of the error sample: --sample, and with --quick at most the
-/// smallest scene.
-std::size_t report_sample_size(const ReportOptions& config) {
-  if (!config.quick) return config.sample;
-  return std::min({config.sample, config.n, config.debris_n, config.pile_n});
-}
-
-enum class SceneKind { pairs, debris, pile, file };
-const char* scene_name(SceneKind kind) {
-  switch (kind) {
-    case SceneKind::pairs:
-      return "pairs";
-    case SceneKind::debris:
-      return "debris";
-    case SceneKind::pile:
-      return "pile";
-    case SceneKind::file:
-      break;
-  }
-  return "file";
-}
-
-/// The caller's scene (ReportOptions::scene_bodies, scene_contacts) in T,
-/// every rule checked as `collide solve` checks it.
-template <class T>
-Scene<T> read_scene_files(const std::string& bodies_path, const std::string& contacts_path) {
-  const LoadedBodies<T> bodies = load_bodies<T>(bodies_path, scene_format_of(bodies_path));
-  const LoadedContacts<T> contacts = load_contacts<T>(contacts_path, scene_format_of(contacts_path), bodies.size());
-  Scene<T> scene;
-  scene.bodies = to_body_buffer(bodies.columns());
-  scene.contacts.assign_exact(contacts.view());
-  return scene;
-}
-
-/// The first `k` contacts of a scene with only the bodies they touch,
-/// renumbered in order of first use. The law applies contacts in input
-/// order, so each of them gets the impulse it gets in the whole scene; the
-/// reference of a sample then needs the sample's bodies, not all of them.
-template <class T>
-Scene<T> contact_prefix(const Scene<T>& scene, std::size_t k) {
-  const ContactView<T> c = scene.contacts.view();
-  const BodyView<const T> b = scene.bodies.view();
-  k = std::min(k, c.count);
-  std::vector<BodyIndex> id(b.count, std::numeric_limits<BodyIndex>::max());
-  std::vector<BodyIndex> used;
-  const auto renumber = [&](BodyIndex i) {
-    if (id[i] == std::numeric_limits<BodyIndex>::max()) {
-      id[i] = static_cast<BodyIndex>(used.size());
-      used.push_back(i);
-    }
-    return id[i];
-  };
-  Scene<T> out;
-  out.contacts.resize(k);
-  for (std::size_t j = 0; j < k; ++j) {
-    ContactRecord<T> r = scene.contacts.record(j);
-    r.a = renumber(r.a);
-    r.b = renumber(r.b);
-    out.contacts.set(j, r);
-  }
-  out.bodies.resize(used.size());
-  for (std::size_t i = 0; i < used.size(); ++i) out.bodies.set(i, scene.bodies.record(used[i]));
-  return out;
-}
-
-/// A generated scene of `n` collisions; the pile of at most `n`, the largest
-/// cubic one (in broadphase cell order, as a user's broadphase hands it).
-template <class T>
-Scene<T> make_scene(SceneKind kind, std::size_t n, bool friction, std::uint64_t seed) {
-  GenerateOptions options;
-  options.seed = seed;
-  options.friction = friction;
-  if (kind == SceneKind::pile) return generate_pile<T>(pile_side_for_contacts(n), options);
-  return kind == SceneKind::pairs ? generate_pairs<T>(n, options) : generate_debris<T>(n, options);
-}
-
-/// Turns a rigid scene into one that `model` fits (see the design notes).
-template <class T>
-void derive_model(Scene<T>& scene, Model model) {
-  BodyView<T> b = scene.bodies.view();
-  for (std::size_t i = 0; i < b.count; ++i) {
-    if (model == Model::sphere) {
-      b.inv_inertia.y[i] = b.inv_inertia.x[i];
-      b.inv_inertia.z[i] = b.inv_inertia.x[i];
-    } else if (model == Model::particle) {
-      b.inv_inertia.x[i] = b.inv_inertia.y[i] = b.inv_inertia.z[i] = T(0);
-      b.w.x[i] = b.w.y[i] = b.w.z[i] = T(0);
-    }
-  }
-  if (const std::string misfit = model_misfit(model, b, scene.contacts.view()); !misfit.empty()) {
-    throw std::logic_error(std::string("derived ") + to_string(model) + " scene does not fit: " + misfit);
-  }
-}
 
 /// The velocities of the first `count` bodies, saved so that every timed run
 /// starts from the same state.
@@ -278,7 +183,7 @@ class Runner {
       report_.phase_seconds.emplace_back(name, seconds_since(phase));
       phase = Clock::now();
     };
-    measure_machine();
+    triad_ = measure_machine(config_, report_.machine, [&](const std::string& what) { progress_->show(what); });
     end_phase("triad");
     for (const SceneKind kind : {SceneKind::pairs, SceneKind::debris, SceneKind::pile}) {
       for (const bool friction : {false, true}) {
@@ -304,77 +209,7 @@ class Runner {
   }
 
  private:
-  // -- machine ---------------------------------------------------------------
-
-  void measure_machine() {
-    MachineInfo& m = report_.machine;
-    {
-      std::ifstream cpuinfo("/proc/cpuinfo");
-      std::string line;
-      while (std::getline(cpuinfo, line)) {
-        if (line.rfind("model name", 0) == 0) {
-          const std::size_t colon = line.find(':');
-          if (colon != std::string::npos) m.cpu = line.substr(colon + 2);
-          break;
-        }
-      }
-      std::ifstream loadavg("/proc/loadavg");
-      loadavg >> m.load_average;
-    }
-    m.hardware_threads = static_cast<unsigned>(sysconf(_SC_NPROCESSORS_ONLN));
-    m.l1d_bytes = cache_bytes(1);
-    m.l2_bytes = cache_bytes(2);
-    m.l3_bytes = cache_bytes(3);
-    {
-      std::string supported;
-      for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
-        if (isa_supported(isa)) supported += std::string(supported.empty() ? "" : ", ") + to_string(isa);
-      }
-      m.simd_build = std::string("simd rows: ") + to_string(default_isa()) + " (this CPU has " + supported +
-                     "): " + std::to_string(simd_width<float>()) + " float / " + std::to_string(simd_width<double>()) +
-                     " double lanes";
-    }
-    progress_->show("isa auto: measuring the ISAs");
-    measure_isa_auto<float>(m.isa_auto);
-    measure_isa_auto<double>(m.isa_auto);
-    for (const int t : config_.threads) {
-      if (std::find(m.triad_threads.begin(), m.triad_threads.end(), t) != m.triad_threads.end()) continue;
-      progress_->show("triad bandwidth, " + std::to_string(t) + " thread(s)");
-      const TriadResult r = measure_triad(t, 0, config_.quick ? 3 : 10);
-      m.triad_threads.push_back(t);
-      m.triad_bytes_per_second.push_back(r.bytes_per_second);
-      m.triad_median_bytes_per_second.push_back(r.median_bytes_per_second);
-      m.triad_array_bytes = r.array_bytes;
-      triad_[t] = r.bytes_per_second;
-    }
-  }
-
-  /// What Isa::automatic picks for every model, accuracy and scene kind in
-  /// T (fastest_isa; the first call of each kind in this process measures).
-  template <class T>
-  static void measure_isa_auto(std::vector<IsaAutoPick>& picks) {
-    for (const Accuracy accuracy : {Accuracy::fast, Accuracy::accurate}) {
-      for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
-        for (const bool scattered : {false, true}) {
-          const IsaMeasurement measured = isa_measurement<T>(model, accuracy, scattered);
-          IsaAutoPick pick;
-          pick.precision = precision_name<T>();
-          pick.model = to_string(model);
-          pick.accuracy = to_string(accuracy);
-          pick.scattered = scattered;
-          pick.isa = to_string(measured.fastest);
-          pick.calibration_seconds = measured.calibration_seconds;
-          for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
-            const double seconds = measured.seconds[static_cast<int>(isa) - static_cast<int>(Isa::sse2)];
-            if (seconds > 0 && measured.contacts > 0) {
-              pick.ns_per_contact.emplace_back(to_string(isa), 1e9 * seconds / static_cast<double>(measured.contacts));
-            }
-          }
-          picks.push_back(std::move(pick));
-        }
-      }
-    }
-  }
+  // -- variants --------------------------------------------------------------
 
   [[nodiscard]] std::size_t expected_rows() const {
     const std::size_t kernel = std::size_t{2} /*precisions*/ * 3 /*models*/ * kernel_variants().size();
