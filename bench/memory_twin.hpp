@@ -5,7 +5,7 @@
 // The triad streams three arrays. A body model's kernel streams many more:
 // on the pairs scene the rigid model reads 17 body arrays, 9 contact arrays
 // (the two indices, c, n, e; 10 with mu) and writes 6 body arrays and 3
-// impulse arrays, all at once. On this machine a core's bandwidth falls with
+// impulse arrays, all at once. On the CPUs measured, a core's bandwidth falls with
 // the number of concurrent streams (the prefetchers follow a limited number
 // of them), so the triad overstates what any kernel with this data layout can
 // reach. The twin measures that directly: the same arrays, visited in the
