@@ -153,19 +153,26 @@ struct PairText {
   std::string bodies, contacts;
 };
 
+/// Checks the options and, when they ask for npz, writes the scene in its
+/// precision and returns true; false leaves CSV to the caller.
+template <class Drawn>
+bool write_npz_if_asked(const Drawn& scene, const DrawnSceneOptions& options, OutputFile& bodies,
+                        OutputFile& contacts) {
+  check_options(options);
+  if (options.format != SceneFormat::npz) return false;
+  if (options.precision == NpyType::f4) {
+    write_npz<float>(scene, bodies, contacts);
+  } else {
+    write_npz<double>(scene, bodies, contacts);
+  }
+  return true;
+}
+
 }  // namespace
 
 void write_drawn_scene(const DrawnScene& scene, const DrawnSceneOptions& options, OutputFile& bodies,
                        OutputFile& contacts) {
-  check_options(options);
-  if (options.format == SceneFormat::npz) {
-    if (options.precision == NpyType::f4) {
-      write_npz<float>(scene, bodies, contacts);
-    } else {
-      write_npz<double>(scene, bodies, contacts);
-    }
-    return;
-  }
+  if (write_npz_if_asked(scene, options, bodies, contacts)) return;
   stream_rows(bodies, bodies_header(), scene.bodies, "bodies", options.progress,
               [&](std::size_t begin, std::size_t end, std::string& text) {
                 BodyRecord<double> body;
@@ -186,15 +193,7 @@ void write_drawn_scene(const DrawnScene& scene, const DrawnSceneOptions& options
 
 void write_drawn_scene(const DrawnPairs& scene, const DrawnSceneOptions& options, OutputFile& bodies,
                        OutputFile& contacts) {
-  check_options(options);
-  if (options.format == SceneFormat::npz) {
-    if (options.precision == NpyType::f4) {
-      write_npz<float>(scene, bodies, contacts);
-    } else {
-      write_npz<double>(scene, bodies, contacts);
-    }
-    return;
-  }
+  if (write_npz_if_asked(scene, options, bodies, contacts)) return;
   bodies.write(bodies_header());
   contacts.write(contacts_header());
   detail::ordered_blocks<PairText>(

@@ -65,34 +65,6 @@ const std::vector<Fixture>& fixtures() {
   return list;
 }
 
-template <class T>
-collide::BodyRecord<double> widen(const collide::BodyRecord<T>& b) {
-  collide::BodyRecord<double> r;
-  r.m = b.m;
-  for (int i = 0; i < 3; ++i) {
-    r.I[i] = b.I[i];
-    r.p[i] = b.p[i];
-    r.v[i] = b.v[i];
-    r.w[i] = b.w[i];
-  }
-  for (int i = 0; i < 4; ++i) r.q[i] = b.q[i];
-  return r;
-}
-
-template <class T>
-collide::ContactRecord<double> widen(const collide::ContactRecord<T>& c) {
-  collide::ContactRecord<double> r;
-  r.a = c.a;
-  r.b = c.b;
-  for (int i = 0; i < 3; ++i) {
-    r.c[i] = c.c[i];
-    r.n[i] = c.n[i];
-  }
-  r.e = c.e;
-  r.mu = c.mu;
-  return r;
-}
-
 void write_text(const std::string& path, const std::string& text) {
   collide::OutputFile out(path);
   out.write(text);
@@ -102,9 +74,10 @@ void write_text(const std::string& path, const std::string& text) {
 void write_fixture(const std::filesystem::path& dir, const SceneRecords<float>& scene) {
   std::filesystem::create_directories(dir);
   std::string bodies(collide::bodies_header());
-  for (const auto& b : scene.bodies) collide::append_body_row<double>(bodies, widen(b));
+  for (const auto& b : scene.bodies) collide::append_body_row<double>(bodies, collide::detail::narrow<double>(b));
   std::string contacts(collide::contacts_header());
-  for (const auto& c : scene.contacts) collide::append_contact_row<double>(contacts, widen(c));
+  for (const auto& c : scene.contacts)
+    collide::append_contact_row<double>(contacts, collide::detail::narrow<double>(c));
   write_text((dir / "bodies.csv").string(), bodies);
   write_text((dir / "contacts.csv").string(), contacts);
 

@@ -517,35 +517,6 @@ TEST(PileScene, SizesAndLimits) {
 // The chain.
 // ---------------------------------------------------------------------------
 
-/// A body record widened to double, value by value (exact).
-template <class T>
-collide::BodyRecord<double> widen(const collide::BodyRecord<T>& r) {
-  collide::BodyRecord<double> o;
-  o.m = r.m;
-  for (int j = 0; j < 3; ++j) {
-    o.I[j] = r.I[j];
-    o.p[j] = r.p[j];
-    o.v[j] = r.v[j];
-    o.w[j] = r.w[j];
-  }
-  for (int j = 0; j < 4; ++j) o.q[j] = r.q[j];
-  return o;
-}
-
-template <class T>
-collide::ContactRecord<double> widen(const collide::ContactRecord<T>& r) {
-  collide::ContactRecord<double> o;
-  o.a = r.a;
-  o.b = r.b;
-  for (int j = 0; j < 3; ++j) {
-    o.c[j] = r.c[j];
-    o.n[j] = r.n[j];
-  }
-  o.e = r.e;
-  o.mu = r.mu;
-  return o;
-}
-
 /// Every contact of a scene approaches by more than `margin`, u . n computed
 /// in double from the stored bodies and contacts (a float scene widened
 /// exactly), with the pile's helper.
@@ -704,9 +675,9 @@ TEST(ChainScene, EveryContactApproachesAtBoundedSpeeds) {
       collide::draw_chain_body(o, n, c.b, b);
       ASSERT_LT(record_approach_speed(a, b, c), -0.4) << k;
       if (in_float) {
-        const auto af = widen(collide::detail::narrow<float>(a));
-        const auto bf = widen(collide::detail::narrow<float>(b));
-        const auto cf = widen(collide::detail::narrow<float>(c));
+        const auto af = collide::detail::narrow<double>(collide::detail::narrow<float>(a));
+        const auto bf = collide::detail::narrow<double>(collide::detail::narrow<float>(b));
+        const auto cf = collide::detail::narrow<double>(collide::detail::narrow<float>(c));
         ASSERT_LT(record_approach_speed(af, bf, cf), -0.4) << k;
       }
       for (int j = 0; j < 3; ++j) fastest = std::max({fastest, std::fabs(a.v[j]), std::fabs(b.v[j])});

@@ -68,10 +68,12 @@ Scene<S> convert_scene(const Scene<U>& src) {
 // rounded once by static_cast, nothing renormalised, so the stored values are
 // exactly what the kernel and the reference then read. The generators
 // (io/generate.hpp) and the hard scenes (eval/hard_scenes.hpp) draw in double.
+// The same cast takes a record of any precision U to T: narrow<double> of a
+// float record widens it, exactly.
 namespace collide::detail {
 
-template <class T>
-BodyRecord<T> narrow(const BodyRecord<double>& r) {
+template <class T, class U = double>
+BodyRecord<T> narrow(const BodyRecord<U>& r) {
   BodyRecord<T> o;
   o.m = static_cast<T>(r.m);
   for (int k = 0; k < 3; ++k) {
@@ -84,8 +86,8 @@ BodyRecord<T> narrow(const BodyRecord<double>& r) {
   return o;
 }
 
-template <class T>
-ContactRecord<T> narrow(const ContactRecord<double>& r) {
+template <class T, class U = double>
+ContactRecord<T> narrow(const ContactRecord<U>& r) {
   ContactRecord<T> o;
   o.a = r.a;
   o.b = r.b;
