@@ -6,8 +6,10 @@
 //    reads one random word per body instead of two (the inverse mass and the
 //    batch), and the inverse masses are read once, in order.
 // 2. Level pass (sequential, in input order): contact k gets batch
-//    max(body_next_[a], body_next_[b]) over its movable bodies, and those
-//    bodies' entries become that batch + 1. The level of contact k depends on
+//    max(body_next_[a], body_next_[b]) over its movable bodies, or its
+//    window's floor if that is higher (schedule.hpp, "Level windows"), and
+//    those bodies' entries become that batch + 1. At each window boundary the
+//    levels of the window just done (in L2) are scanned for their span. The level of contact k depends on
 //    every earlier contact, so this pass cannot be split exactly (a chunk's
 //    levels are a max-plus function of every body's incoming batch, and
 //    evaluating it costs a second pass). On scattered bodies (the debris
@@ -51,6 +53,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
@@ -143,6 +146,12 @@ __attribute__((noinline, cold)) void throw_bad_contact(const BodyIndex* a, const
 /// (1024 measured slower: 12% over the unchecked build on pairs).
 constexpr std::size_t kCheckBlock = 256;
 
+/// The level windows of schedule.hpp: their size is a multiple of
+/// kCheckBlock, so that every window starts a block.
+constexpr std::size_t kLevelWindow = Schedule::kLevelWindow;
+constexpr std::uint32_t kShallowWindowLevels = Schedule::kShallowWindowLevels;
+static_assert(kLevelWindow % kCheckBlock == 0);
+
 /// Whether every contact of [0, count) has both indices < bound and a != b.
 /// Branch-free, so that it vectorises; with GCC on x86-64 it is also
 /// compiled for AVX2 and picked at load time (an ifunc), as validate.cpp's
@@ -169,7 +178,20 @@ inline void check_indices(const BodyIndex* a, const BodyIndex* b, std::size_t k,
   if (__builtin_expect(!indices_below(a + k, b + k, end - k, bound), 0)) throw_bad_contact(a, b, k, end, body_count);
 }
 
-/// Pass 2 from contact k on: the level of each contact from the body table.
+/// The lowest and highest of level[begin, end), as a loop that vectorises.
+template <class Word>
+std::pair<std::uint32_t, std::uint32_t> level_span(const Word* level, std::size_t begin, std::size_t end) {
+  Word lowest = std::numeric_limits<Word>::max();
+  Word highest = 0;
+  for (std::size_t k = begin; k < end; ++k) {
+    lowest = std::min(lowest, level[k]);
+    highest = std::max(highest, level[k]);
+  }
+  return {lowest, highest};
+}
+
+/// Pass 2 from contact k on: the level of each contact from the body table
+/// and the window's floor (`window_floor`, carried in and out).
 /// Raises `levels` to the number of levels, adds the dependencies met to
 /// `conflicts`, and returns the contact where it stopped: n, or for a narrow
 /// Word the first contact whose level + 1 would not fit below the sentinel,
@@ -181,9 +203,10 @@ inline void check_indices(const BodyIndex* a, const BodyIndex* b, std::size_t k,
 template <class Word>
 std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __restrict b, std::size_t k, std::size_t n,
                           std::size_t body_count, Word* __restrict next, Word* __restrict level, std::uint32_t& levels,
-                          std::size_t& conflicts) {
+                          std::size_t& conflicts, std::uint32_t& window_floor) {
   constexpr Word immovable = kImmovableWord<Word>;
   std::uint32_t count = levels;
+  Word floor = static_cast<Word>(window_floor);
   std::size_t met = 0;
   const auto one = [&](std::size_t c) {
     const BodyIndex i = a[c];
@@ -194,7 +217,7 @@ std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __rest
     const bool movable_j = next_j != immovable;
     const Word after_i = movable_i ? next_i : Word{0};
     const Word after_j = movable_j ? next_j : Word{0};
-    const Word L = std::max(after_i, after_j);
+    const Word L = std::max(std::max(after_i, after_j), floor);
     if constexpr (sizeof(Word) < sizeof(std::uint32_t)) {
       if (L == immovable - 1) return false;
     }
@@ -210,12 +233,19 @@ std::size_t assign_levels(const BodyIndex* __restrict a, const BodyIndex* __rest
   };
   const auto stop = [&](std::size_t at) {
     levels = count;
+    window_floor = floor;
     conflicts += met;
     return at;
   };
   const std::size_t ahead = n > kPrefetchDistance ? n - kPrefetchDistance : 0;
   while (k < n) {
-    const std::size_t end = std::min(n, k + kCheckBlock);
+    // Blocks start at multiples of kCheckBlock, also after a narrow pass
+    // stopped mid-block, so that every window boundary starts a block.
+    const std::size_t end = std::min(n, (k / kCheckBlock + 1) * kCheckBlock);
+    if (k % kLevelWindow == 0 && k > 0) {
+      const auto [lowest, highest] = level_span(level, k - kLevelWindow, k);
+      if (highest - lowest < kShallowWindowLevels) floor = static_cast<Word>(count - 1);
+    }
     check_indices(a, b, k, end, body_count);
     // The next block's indices: its check reads them in a burst, which on
     // scattered scenes otherwise waits on memory once per block.
@@ -257,6 +287,24 @@ void count_levels(const Level* level, std::size_t begin, std::size_t end, std::u
     }
   } else {
     for (std::size_t k = begin; k < end; ++k) ++count[level[k]];
+  }
+}
+
+/// Writes each contact k of [begin, end) to order[next_slot[level[k]]++].
+/// A run of contacts of one level (most of a window's contacts, schedule.hpp)
+/// keeps its slot in a register: incrementing it in memory for every contact
+/// made each store wait on the one before.
+template <class Level>
+void scatter_by_level(const Level* level, std::size_t begin, std::size_t end, std::uint32_t* next_slot,
+                      std::uint32_t* order) {
+  std::size_t k = begin;
+  while (k < end) {
+    const Level L = level[k];
+    std::uint32_t slot = next_slot[L];
+    do {
+      order[slot++] = static_cast<std::uint32_t>(k++);
+    } while (k < end && level[k] == L);
+    next_slot[L] = slot;
   }
 }
 
@@ -326,15 +374,18 @@ void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_co
     fill_body_table(inv_mass, stride, 0, body_count, next8);
     std::uint32_t levels = 0;
     std::size_t conflicts = 0;
-    const std::size_t stop = assign_levels(contacts.a, contacts.b, 0, n, body_count, next8,
-                                           reinterpret_cast<std::uint8_t*>(level_.data()), levels, conflicts);
+    std::uint32_t window_floor = 0;  // carried across the switch to wide words
+    const std::size_t stop =
+        assign_levels(contacts.a, contacts.b, 0, n, body_count, next8, reinterpret_cast<std::uint8_t*>(level_.data()),
+                      levels, conflicts, window_floor);
     contact_count_ = n;
     if (stop == n) {
       sort_by_level(reinterpret_cast<const std::uint8_t*>(level_.data()), levels, workers);
     } else {
       widen(body_next_, body_count);
       widen(level_, n);
-      assign_levels(contacts.a, contacts.b, stop, n, body_count, body_next_.data(), level_.data(), levels, conflicts);
+      assign_levels(contacts.a, contacts.b, stop, n, body_count, body_next_.data(), level_.data(), levels, conflicts,
+                    window_floor);
       sort_by_level(static_cast<const std::uint32_t*>(level_.data()), levels, workers);
     }
     body_count_ = body_count;
@@ -362,7 +413,7 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
     // shifting by one restores starts.
     count_levels(level, 0, n, batch_begin_.data() + 1);
     for (std::size_t L = 1; L <= levels; ++L) batch_begin_[L] += batch_begin_[L - 1];
-    for (std::size_t k = 0; k < n; ++k) order[batch_begin_[level[k]]++] = static_cast<std::uint32_t>(k);
+    scatter_by_level(level, 0, n, batch_begin_.data(), order);
     for (std::size_t L = levels; L > 0; --L) batch_begin_[L] = batch_begin_[L - 1];
     batch_begin_[0] = 0;
   } else {
@@ -387,7 +438,7 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
     batch_begin_[levels] = start;
     for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
       std::uint32_t* const next_slot = slot + c * levels;
-      for (std::size_t k = begin; k < end; ++k) order[next_slot[level[k]]++] = static_cast<std::uint32_t>(k);
+      scatter_by_level(level, begin, end, next_slot, order);
     });
   }
 

@@ -216,16 +216,27 @@ struct Topology {
 };
 
 /// The level rule, plainly: contact k goes one batch past the latest batch of
-/// the earlier contacts of its movable bodies; batches hold their contacts in
-/// input order.
+/// the earlier contacts of its movable bodies, and no lower than its window's
+/// floor: the highest level before the window, when the contacts of the
+/// window before it spanned at most Schedule::kShallowWindowLevels levels
+/// (else the floor stays).
+/// Batches hold their contacts in input order.
 struct ReferenceSchedule {
   std::vector<std::vector<std::uint32_t>> batches;
   std::size_t conflicts = 0;
 
   explicit ReferenceSchedule(const Topology& t) {
     std::vector<std::size_t> batch_count_of_body(t.inv_mass.size(), 0);  // batches the body is already in
+    std::size_t floor = 0;
+    std::size_t lowest = std::numeric_limits<std::size_t>::max();  // of the levels in the current window
+    std::size_t highest = 0;
     for (std::size_t k = 0; k < t.a.size(); ++k) {
-      std::size_t level = 0;
+      if (k % Schedule::kLevelWindow == 0 && k > 0) {
+        if (highest - lowest < Schedule::kShallowWindowLevels) floor = batches.size() - 1;
+        lowest = std::numeric_limits<std::size_t>::max();
+        highest = 0;
+      }
+      std::size_t level = floor;
       for (const BodyIndex i : {t.a[k], t.b[k]}) {
         if (t.inv_mass[i] == 0) continue;
         level = std::max(level, batch_count_of_body[i]);
@@ -236,6 +247,8 @@ struct ReferenceSchedule {
       }
       if (batches.size() <= level) batches.resize(level + 1);
       batches[level].push_back(static_cast<std::uint32_t>(k));
+      lowest = std::min(lowest, level);
+      highest = std::max(highest, level);
     }
   }
 };
@@ -358,6 +371,62 @@ TEST(Schedule, EqualsPlainLevelRuleOnEveryShapeAndThreadCount) {
       s.build(view, t.inv_mass.size(), t.inv_mass.data(), threads == 1 ? 2 : 1);
       expect_reference(t, s);
     }
+  }
+}
+
+// Debris over several level windows: every batch lies within two neighbouring
+// windows, so the kernel reads it from one stretch of the input; the plain rule
+// (no floor) spreads the first batches over the whole input. A chain (each
+// window spans all its contacts' levels) keeps one contact per batch.
+TEST(Schedule, ShallowWindowsKeepTheirBatchesTogether) {
+  const Topology debris = debris_topology(6 * Schedule::kLevelWindow + 123, 11);
+  ContactView<float> view;
+  view.count = debris.a.size();
+  view.a = debris.a.data();
+  view.b = debris.b.data();
+  Schedule s;
+  s.build(view, debris.inv_mass.size(), debris.inv_mass.data(), 2);
+  ASSERT_GT(s.batch_count(), 6u);
+  for (std::size_t k = 0; k < s.batch_count(); ++k) {
+    const std::vector<std::uint32_t> contacts = batch(s, k);
+    ASSERT_FALSE(contacts.empty()) << "batch " << k;
+    EXPECT_LE(contacts.back() / Schedule::kLevelWindow - contacts.front() / Schedule::kLevelWindow, 1u)
+        << "batch " << k << " spans windows " << contacts.front() / Schedule::kLevelWindow << " to "
+        << contacts.back() / Schedule::kLevelWindow;
+  }
+
+  const std::size_t n = 2 * Schedule::kLevelWindow + 7;
+  Topology chain{"chain", {}, {}, std::vector<float>(n + 1, 1.0f)};
+  for (std::size_t k = 0; k < n; ++k) {
+    chain.a.push_back(static_cast<BodyIndex>(k));
+    chain.b.push_back(static_cast<BodyIndex>(k + 1));
+  }
+  view.count = n;
+  view.a = chain.a.data();
+  view.b = chain.b.data();
+  s.build(view, chain.inv_mass.size(), chain.inv_mass.data(), 2);
+  EXPECT_EQ(s.batch_count(), n);
+  expect_reference(chain, s);
+
+  // The chain, then debris on bodies of their own: deep windows, then shallow
+  // ones whose floors start from the chain's last level. The level pass
+  // switches to wide words mid-window (at contact 254) and must still cut
+  // windows at their boundaries.
+  Topology both = chain;
+  both.name = "chain, then debris";
+  const auto first = static_cast<BodyIndex>(both.inv_mass.size());
+  both.inv_mass.resize(first + debris.inv_mass.size(), 1.0f);
+  for (std::size_t i = 0; i < debris.inv_mass.size(); ++i) both.inv_mass[first + i] = debris.inv_mass[i];
+  for (std::size_t k = 0; k < debris.a.size(); ++k) {
+    both.a.push_back(first + debris.a[k]);
+    both.b.push_back(first + debris.b[k]);
+  }
+  view.count = both.a.size();
+  view.a = both.a.data();
+  view.b = both.b.data();
+  for (const int threads : {1, 2}) {
+    s.build(view, both.inv_mass.size(), both.inv_mass.data(), threads);
+    expect_reference(both, s);
   }
 }
 

@@ -16,6 +16,21 @@
 // greedy colouring would give fewer batches on some graphs, but a result that
 // depends on the colouring heuristic; this one depends only on the input.
 //
+// Level windows. On a scattered scene (debris: random bodies) the plain rule
+// puts a contact of level 0 everywhere in the input, and of level 1, 2, ...
+// too, so every batch spans the whole input and the kernel reads each line of
+// the contact arrays once per batch that has a contact in it. So the rule has
+// a floor: the input is cut into windows of kLevelWindow contacts, and when the
+// window before was shallow (its contacts' levels span fewer than
+// kShallowWindowLevels), the contacts of the next one go no lower than the
+// highest level so far. A
+// shallow window's contacts then fill a few batches of their own, read from
+// one stretch of the input while it is in cache. A deep window (a pile swept
+// cell by cell, a chain) sets no floor: its levels already follow the input.
+// The floor only ever raises a level, so every body still sees its contacts
+// in input order and the result is the same, bit for bit; the batches depend
+// on the input alone, not on the thread count.
+//
 // Immovable bodies (inverse mass 0) are never written by the kernels, so they
 // never conflict: a million debris contacts on one ground body form one batch.
 //
@@ -47,6 +62,11 @@ namespace collide {
 
 class Schedule {
  public:
+  /// Contacts per level window (design notes above).
+  static constexpr std::size_t kLevelWindow = std::size_t{1} << 16;
+  /// A window whose levels span fewer than this raises the floor of the next.
+  static constexpr std::uint32_t kShallowWindowLevels = 16;
+
   /// Builds the schedule. Bodies with inv_mass == 0 do not conflict.
   /// `bodies` is any body view (BodyView, SphereView, ParticleView): only
   /// its count and inverse masses are read. `threads`: at most this many
