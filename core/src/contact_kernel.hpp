@@ -423,38 +423,71 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
   return r;
 }
 
+/// What the law needs of a contact that does not depend on the velocities:
+/// the offsets and the lever arms along n. A run of contacts that must be
+/// applied one after another (solve_run in kernel_isa.cpp) forms these in
+/// lanes first and then walks the contacts one by one with them; the one
+/// kernel body below forms them in place. Either way the same operations.
+template <class V>
+struct ContactGeometry {
+  Vec3<V> ra;  // [m] c - pa (sphere, rigid)
+  Vec3<V> rb;  // [m] c - pb
+  LeverArm<V> arm_a;
+  LeverArm<V> arm_b;
+};
+
+/// Forms the geometry of W contacts; zeroes immovable bodies' inverse moments
+/// first, as the law does.
+template <class M, class V>
+COLLIDE_LANE_INLINE ContactGeometry<V> contact_geometry(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                        const ContactLanes<V>& contact) {
+  zero_immovable_inertia(a);
+  zero_immovable_inertia(b);
+  ContactGeometry<V> g{};
+  if constexpr (kRotates<M>) {
+    g.ra = contact.c - a.p;
+    g.rb = contact.c - b.p;
+  }
+  g.arm_a = lever_arm(a, g.ra, contact.n, contact.c);
+  g.arm_b = lever_arm(b, g.rb, contact.n, contact.c);
+  return g;
+}
+
+/// The normal impulse of W contacts from their geometry and the bodies'
+/// velocities now, in the mode `Mode`.
+template <class M, class V, class Mode>
+COLLIDE_LANE_INLINE NormalImpulse<V> normal_impulse(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                                    const ContactLanes<V>& contact, const ContactGeometry<V>& g) {
+  const Vec3<V>& n = contact.n;
+  Vec3<V> u{};
+  if constexpr (kRotates<M> || std::is_same_v<Mode, AccurateMode>) u = relative_velocity(a, b, g.ra, g.rb);
+  NormalImpulse<V> normal;
+  if constexpr (std::is_same_v<Mode, FastMode>) {
+    normal = fast_normal_impulse(a, b, u, n, contact.e, g.arm_a, g.arm_b);
+  } else {
+    // The accurate mode's lanes carry n normalised and every digit needed.
+    const V vn = dot(u, n);
+    const V k_n = inverse_effective_mass(a, b, g.arm_a, g.arm_b);
+    normal.approaching = (vn < V(0)) && (k_n > V(0));
+    // Inactive lanes may divide by zero here; their result is discarded.
+    normal.jn = select(normal.approaching, -((V(1) + contact.e) * vn) / k_n, V(0));
+  }
+  return normal;
+}
+
 /// The law for W contacts whose bodies are pairwise distinct (or immovable),
 /// evaluated in the lanes V. kFriction selects the Coulomb step; without it
 /// `mu` is never read.
 template <class M, class V, bool kFriction, class Mode>
 COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                   const ContactLanes<V>& contact) {
-  zero_immovable_inertia(a);
-  zero_immovable_inertia(b);
   const Vec3<V>& n = contact.n;
-  Vec3<V> ra{};
-  Vec3<V> rb{};
-  if constexpr (kRotates<M>) {
-    ra = contact.c - a.p;
-    rb = contact.c - b.p;
-  }
-
-  Vec3<V> u{};
-  if constexpr (kRotates<M> || std::is_same_v<Mode, AccurateMode>) u = relative_velocity(a, b, ra, rb);
-  const LeverArm<V> arm_a = lever_arm(a, ra, n, contact.c);
-  const LeverArm<V> arm_b = lever_arm(b, rb, n, contact.c);
-
-  NormalImpulse<V> normal;
-  if constexpr (std::is_same_v<Mode, FastMode>) {
-    normal = fast_normal_impulse(a, b, u, n, contact.e, arm_a, arm_b);
-  } else {
-    // The accurate mode's lanes carry n normalised and every digit needed.
-    const V vn = dot(u, n);
-    const V k_n = inverse_effective_mass(a, b, arm_a, arm_b);
-    normal.approaching = (vn < V(0)) && (k_n > V(0));
-    // Inactive lanes may divide by zero here; their result is discarded.
-    normal.jn = select(normal.approaching, -((V(1) + contact.e) * vn) / k_n, V(0));
-  }
+  const ContactGeometry<V> g = contact_geometry(a, b, contact);
+  const Vec3<V>& ra = g.ra;
+  const Vec3<V>& rb = g.rb;
+  const LeverArm<V>& arm_a = g.arm_a;
+  const LeverArm<V>& arm_b = g.arm_b;
+  const NormalImpulse<V> normal = normal_impulse<M, V, Mode>(a, b, contact, g);
   const auto& approaching = normal.approaching;
   const V& jn = normal.jn;
   apply_impulse(a, b, n, jn, arm_a, arm_b, approaching);

@@ -324,6 +324,195 @@ std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size
                       : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
 }
 
+/// Contacts per piece of a sequential run (solve_run): the geometry of a
+/// piece, 64 bytes a contact in float, stays in L1 between the two passes.
+inline constexpr std::size_t kRunPiece = 128;
+
+/// The geometry of a piece (ContactGeometry) and the inverse masses, one
+/// array per value: the first pass stores lanes, the second reads one value.
+template <class T>
+struct RunPiece {
+  alignas(64) T ra[3][kRunPiece];
+  alignas(64) T rb[3][kRunPiece];
+  alignas(64) T response_a[3][kRunPiece];
+  alignas(64) T response_b[3][kRunPiece];
+  alignas(64) T k_a[kRunPiece];
+  alignas(64) T k_b[kRunPiece];
+  alignas(64) T inv_mass_a[kRunPiece];
+  alignas(64) T inv_mass_b[kRunPiece];
+};
+
+template <class V>
+COLLIDE_LANE_INLINE void store3(const Vec3<V>& v, typename V::value_type (*to)[kRunPiece], std::size_t at) {
+  store(v.x, to[0] + at);
+  store(v.y, to[1] + at);
+  store(v.z, to[2] + at);
+}
+template <class S>
+COLLIDE_LANE_INLINE Vec3<S> load3(const typename S::value_type (*from)[kRunPiece], std::size_t at) {
+  return {S(from[0][at]), S(from[1][at]), S(from[2][at])};
+}
+
+/// First pass: the geometry of the W contacts order[at], ... of a piece, in
+/// lanes, from the bodies' positions, orientations and inverse masses (their
+/// velocities are read with the record and ignored: the second pass reads
+/// them as the contacts before have left them).
+template <class M, class V, class T, class View>
+COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* index,
+                                      RunPiece<T>& piece, std::size_t at) {
+  constexpr std::size_t W = V::size();
+  BodyIndex ia[W];
+  BodyIndex ib[W];
+  for (std::size_t l = 0; l < W; ++l) {
+    ia[l] = contacts.a[index[l]];
+    ib[l] = contacts.b[index[l]];
+    assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
+  }
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  if constexpr (kSoaLayout<View>) {
+    read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      la = gather<V>(field, ia);
+      lb = gather<V>(field, ib);
+    });
+  } else {
+    read_records<M, V>(bodies, ia, a);
+    read_records<M, V>(bodies, ib, b);
+  }
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>)
+    c.c = {gather<V>(contacts.c.x, index), gather<V>(contacts.c.y, index), gather<V>(contacts.c.z, index)};
+  c.n = {gather<V>(contacts.n.x, index), gather<V>(contacts.n.y, index), gather<V>(contacts.n.z, index)};
+  const ContactGeometry<V> g = contact_geometry(a, b, c);
+  store(a.inv_mass, piece.inv_mass_a + at);
+  store(b.inv_mass, piece.inv_mass_b + at);
+  if constexpr (kRotates<M>) {
+    store3(g.ra, piece.ra, at);
+    store3(g.rb, piece.rb, at);
+    store3(g.arm_a.response, piece.response_a, at);
+    store3(g.arm_b.response, piece.response_b, at);
+    store(g.arm_a.k, piece.k_a + at);
+    store(g.arm_b.k, piece.k_b + at);
+  }
+}
+
+/// Body i's velocities, one lane: SoA arrays or the first values of its
+/// record (record_lanes.hpp asserts that order).
+template <class M, class S, class View>
+COLLIDE_LANE_INLINE void read_velocities(const View& view, BodyIndex i, BodyLanes<M, S>& body) {
+  using T = typename S::value_type;
+  if constexpr (kSoaLayout<View>) {
+    body.v = {S(view.v.x[i]), S(view.v.y[i]), S(view.v.z[i])};
+    if constexpr (kRotates<M>) body.w = {S(view.w.x[i]), S(view.w.y[i]), S(view.w.z[i])};
+  } else {
+    const T* r = reinterpret_cast<const T*>(view.bodies + i);
+    body.v = {S(r[0]), S(r[1]), S(r[2])};
+    if constexpr (kRotates<M>) body.w = {S(r[3]), S(r[4]), S(r[5])};
+  }
+}
+template <class M, class S, class View>
+COLLIDE_LANE_INLINE void write_velocities(const View& view, BodyIndex i, const BodyLanes<M, S>& body) {
+  using T = typename S::value_type;
+  T* v[3];
+  T* w[3];
+  if constexpr (kSoaLayout<View>) {
+    v[0] = view.v.x + i, v[1] = view.v.y + i, v[2] = view.v.z + i;
+    if constexpr (kRotates<M>) w[0] = view.w.x + i, w[1] = view.w.y + i, w[2] = view.w.z + i;
+  } else {
+    T* r = reinterpret_cast<T*>(view.bodies + i);
+    v[0] = r, v[1] = r + 1, v[2] = r + 2;
+    if constexpr (kRotates<M>) w[0] = r + 3, w[1] = r + 4, w[2] = r + 5;
+  }
+  *v[0] = body.v.x[0], *v[1] = body.v.y[0], *v[2] = body.v.z[0];
+  if constexpr (kRotates<M>) *w[0] = body.w.x[0], *w[1] = body.w.y[0], *w[2] = body.w.z[0];
+}
+
+/// A run of contacts order[begin, end) applied one after another (a chain, a
+/// stack: batches of a contact or a few), frictionless, in the fast mode.
+/// What does not depend on the velocities (the offsets, the lever arms and
+/// their K terms: most of the arithmetic, and all of the wide lever arms'
+/// work) is formed for a piece of kRunPiece contacts in lanes of V, whose
+/// bodies' positions and orientations no contact of the run changes; then the
+/// contacts are walked in order in one lane, each reading the velocities the
+/// contacts before it left. Every value is formed by the operations
+/// evaluate_law performs on it (contact_geometry, normal_impulse,
+/// apply_impulse), so the bits are those of the one-lane kernel.
+template <class M, class V, class T, class View>
+void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                      const std::uint32_t* order, std::size_t begin, std::size_t end) {
+  using S = ScalarLanes<T>;
+  constexpr std::size_t W = V::size();
+  RunPiece<T> piece;
+  for (std::size_t first = begin; first < end; first += kRunPiece) {
+    const std::size_t count = std::min(kRunPiece, end - first);
+    std::size_t at = 0;
+    for (; at + W <= count; at += W) run_geometry<M, V, T>(bodies, contacts, order + first + at, piece, at);
+    for (; at < count; ++at) run_geometry<M, S, T>(bodies, contacts, order + first + at, piece, at);
+    for (std::size_t j = 0; j < count; ++j) {
+      const std::uint32_t k = order[first + j];
+      const BodyIndex ia = contacts.a[k];
+      const BodyIndex ib = contacts.b[k];
+      BodyLanes<M, S> a;
+      BodyLanes<M, S> b;
+      a.inv_mass = S(piece.inv_mass_a[j]);
+      b.inv_mass = S(piece.inv_mass_b[j]);
+      read_velocities<M, S>(bodies, ia, a);
+      read_velocities<M, S>(bodies, ib, b);
+      ContactLanes<S> c;
+      c.n = {S(contacts.n.x[k]), S(contacts.n.y[k]), S(contacts.n.z[k])};
+      c.e = S(contacts.e != nullptr ? contacts.e[k] : contacts.uniform_e);
+      ContactGeometry<S> g{};
+      if constexpr (kRotates<M>) {
+        g.ra = load3<S>(piece.ra, j);
+        g.rb = load3<S>(piece.rb, j);
+        g.arm_a = {load3<S>(piece.response_a, j), S(piece.k_a[j])};
+        g.arm_b = {load3<S>(piece.response_b, j), S(piece.k_b[j])};
+      }
+      const NormalImpulse<S> normal = normal_impulse<M, S, FastMode>(a, b, c, g);
+      apply_impulse(a, b, c.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
+      if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
+      if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
+      const Vec3<S> jv = c.n * normal.jn;
+      impulses.j.x[k] = jv.x[0];
+      impulses.j.y[k] = jv.y[0];
+      impulses.j.z[k] = jv.z[0];
+    }
+  }
+}
+
+/// A run of the job (solve_run_pieces); the accurate mode and friction take
+/// the one-lane kernel, contact by contact.
+template <class T>
+void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
+  if (job.accurate || job.friction) {
+    solve_range_scalar<T>(job, false, begin, end);
+    return;
+  }
+  using V = SimdLanes<T>;
+  const auto run = [&](const auto& view, auto model) {
+    solve_run_pieces<decltype(model), V, T>(view, job.contacts, job.impulses, job.order, begin, end);
+  };
+  if (job.packed) {
+    switch (job.model) {
+      case Model::particle:
+        return run(job.packed_particle, ParticleModel{});
+      case Model::sphere:
+        return run(job.packed_sphere, SphereModel{});
+      case Model::rigid:
+        return run(job.packed_rigid, RigidModel{});
+    }
+  }
+  switch (job.model) {
+    case Model::particle:
+      return run(job.particle, ParticleModel{});
+    case Model::sphere:
+      return run(job.sphere, SphereModel{});
+    case Model::rigid:
+      break;
+  }
+  run(job.rigid, RigidModel{});
+}
+
 }  // namespace
 }  // namespace COLLIDE_KERNEL_NS
 
@@ -353,8 +542,13 @@ Isa this_isa() {
 }  // namespace
 
 const KernelTable& COLLIDE_CONCAT(kernel_table_, COLLIDE_KERNEL_NS)() {
-  static const KernelTable table{this_isa(), SimdLanes<float>::size(), SimdLanes<double>::size(),
-                                 &solve_range_simd<float>, &solve_range_simd<double>};
+  static const KernelTable table{this_isa(),
+                                 SimdLanes<float>::size(),
+                                 SimdLanes<double>::size(),
+                                 &solve_range_simd<float>,
+                                 &solve_range_simd<double>,
+                                 &solve_run<float>,
+                                 &solve_run<double>};
   return table;
 }
 

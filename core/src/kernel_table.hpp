@@ -56,6 +56,11 @@ struct KernelJob {
 template <class T>
 using RangeKernel = void (*)(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
 
+/// Resolves order[begin, end) one contact after another: a run of batches
+/// too small to fill the lanes (a chain), whose contacts may share bodies.
+template <class T>
+using RunKernel = void (*)(const KernelJob<T>& job, std::size_t begin, std::size_t end);
+
 /// The SIMD kernels of one instruction set.
 struct KernelTable {
   Isa isa = Isa::sse2;
@@ -63,6 +68,8 @@ struct KernelTable {
   std::size_t lanes_double = 0;
   RangeKernel<float> simd_float = nullptr;
   RangeKernel<double> simd_double = nullptr;
+  RunKernel<float> run_float = nullptr;
+  RunKernel<double> run_double = nullptr;
 };
 
 /// The table of a concrete ISA (not automatic) that this build has.

@@ -201,6 +201,15 @@ RangeKernel<T> simd_kernel(const KernelTable& table) {
 }
 
 template <class T>
+RunKernel<T> run_kernel(const KernelTable& table) {
+  if constexpr (std::is_same_v<T, float>) {
+    return table.run_float;
+  } else {
+    return table.run_double;
+  }
+}
+
+template <class T>
 std::size_t simd_lanes(const KernelTable& table) {
   return std::is_same_v<T, float> ? table.lanes_float : table.lanes_double;
 }
@@ -217,6 +226,7 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
   const RangeKernel<T> kernel = simd ? simd_kernel<T>(table) : &solve_range_scalar<T>;
 
   const std::size_t batches = schedule.batch_count();
+
   arena.execute([&] {
     const bool one_thread = arena.max_concurrency() == 1;
     // Whether the one-lane kernel runs all of a batch of n contacts on this
@@ -229,12 +239,18 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
       const std::size_t n = end - begin;
       if (one_lane(n) && k + 1 < batches && one_lane(schedule.batch_begin(k + 2) - end)) {
         // A run of such batches (a chain, a stack, a column: one contact per
-        // level) goes to the one-lane kernel in one call, in schedule order.
-        // That is the law's order, and each of these contacts would have run
-        // in that kernel anyway (on the SIMD path as a range's tail), so the
-        // bits are the same; only the call and dispatch per batch are saved.
+        // level) is applied contact after contact in one call, in schedule
+        // order. That is the law's order, and each of these contacts would
+        // have run in the one-lane kernel anyway (on the SIMD path as a
+        // range's tail), whose bits the run kernel keeps (kernel_isa.cpp,
+        // solve_run); only the call and dispatch per batch are saved, and on
+        // the SIMD path the lever arms are formed in lanes.
         while (k + 1 < batches && one_lane(schedule.batch_begin(k + 2) - end)) end = schedule.batch_begin(++k + 1);
-        solve_range_scalar<T>(job, false, begin, end);
+        if (simd) {
+          run_kernel<T>(table)(job, begin, end);
+        } else {
+          solve_range_scalar<T>(job, false, begin, end);
+        }
         continue;
       }
       const bool contiguous = schedule.batch_is_contiguous(k);
