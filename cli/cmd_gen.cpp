@@ -35,7 +35,8 @@
 namespace collide::cli {
 
 const char* const kGenUsage =
-    "usage: collide gen (--pairs N | --debris N | --pile S [--shuffle]) --out DIR\n"
+    "usage: collide gen (--pairs N | --debris N | --pile S [--shuffle] | --chain N)\n"
+    "                   --out DIR\n"
     "                   [--seed S] [--friction] [--model rigid|sphere|particle]\n"
     "                   [--format csv|npz] [--precision float|double] [--threads N]\n"
     "\n"
@@ -52,6 +53,9 @@ const char* const kGenUsage =
     "                 ground body (the last): 3 S^2 (S - 1) + S^2 contacts, listed\n"
     "                 cell by cell as a grid broadphase emits them\n"
     "  --shuffle      the pile's contacts in a random order drawn from the seed\n"
+    "  --chain N      a chain of N + 1 boxes, each touching the next (a staircase:\n"
+    "                 +x, then +y), N contacts in chain order: every contact\n"
+    "                 shares a body with the one before, so they run one by one\n"
     "  --out DIR      output directory\n"
     "  --seed S       64-bit seed (default 1)\n"
     "  --friction     draw mu uniformly from [0, 1) (default: mu = 0)\n"
@@ -128,6 +132,12 @@ DrawnScene debris_scene(std::size_t count, const GenerateOptions& options) {
           [count, options](std::uint64_t k, ContactRecord<double>& c) { draw_debris_contact(options, count, k, c); }};
 }
 
+DrawnScene chain_scene(std::size_t count, const GenerateOptions& options) {
+  return {chain_body_count(count), count,
+          [count, options](std::uint64_t i, BodyRecord<double>& body) { draw_chain_body(options, count, i, body); },
+          [count, options](std::uint64_t k, ContactRecord<double>& c) { draw_chain_contact(options, count, k, c); }};
+}
+
 DrawnScene pile_scene(std::size_t side, const GenerateOptions& options) {
   return {pile_body_count(side), pile_contact_count(side),
           [side, options](std::uint64_t i, BodyRecord<double>& body) { draw_pile_body(options, side, i, body); },
@@ -141,6 +151,7 @@ int run_gen(int argc, char** argv) {
                                     {{"pairs", true},
                                      {"debris", true},
                                      {"pile", true},
+                                     {"chain", true},
                                      {"shuffle", false},
                                      {"out", true},
                                      {"seed", true},
@@ -156,10 +167,11 @@ int run_gen(int argc, char** argv) {
   const bool pairs = opt.count("pairs") != 0;
   const bool debris = opt.count("debris") != 0;
   const bool pile = opt.count("pile") != 0;
-  if (static_cast<int>(pairs) + static_cast<int>(debris) + static_cast<int>(pile) != 1) {
-    throw UsageError("give exactly one of --pairs N, --debris N and --pile S");
+  const bool chain = opt.count("chain") != 0;
+  if (static_cast<int>(pairs) + static_cast<int>(debris) + static_cast<int>(pile) + static_cast<int>(chain) != 1) {
+    throw UsageError("give exactly one of --pairs N, --debris N, --pile S and --chain N");
   }
-  const char* const kind = pairs ? "pairs" : debris ? "debris" : "pile";
+  const char* const kind = pairs ? "pairs" : debris ? "debris" : pile ? "pile" : "chain";
   const unsigned long long n = parse_count(kind, opt.at(kind));
   // Body ids are 32-bit (contacts.hpp): 2N bodies for pairs, N/2 + 1 for
   // debris, S^3 + 1 for a pile.
@@ -167,10 +179,10 @@ int run_gen(int argc, char** argv) {
     throw UsageError("--pile " + opt.at("pile") + " is too large: at most " + std::to_string(kMaxPileSide) +
                      " boxes per side (body ids are 32-bit)");
   }
-  const unsigned long long max_n = pairs ? 0x7FFFFFFFULL : 0xFFFFFFFFULL;
+  const unsigned long long max_n = pairs ? 0x7FFFFFFFULL : chain ? kMaxChainContacts : 0xFFFFFFFFULL;
   if (n > max_n) throw UsageError("scene too large: body ids are 32-bit");
   if (opt.count("shuffle") != 0 && !pile) {
-    throw UsageError("--shuffle is for --pile (the pairs and debris contacts have no spatial order to shuffle)");
+    throw UsageError("--shuffle is for --pile (the pairs, debris and chain contacts have no cell order to shuffle)");
   }
   const std::string& dir = required(opt, "out");
   GenerateOptions options;
@@ -218,7 +230,10 @@ int run_gen(int argc, char** argv) {
   if (pairs) {
     write_drawn_scene(pairs_scene(count, options), how, bodies, contacts);
   } else {
-    write_drawn_scene(debris ? debris_scene(count, options) : pile_scene(count, options), how, bodies, contacts);
+    write_drawn_scene(debris ? debris_scene(count, options)
+                      : pile ? pile_scene(count, options)
+                             : chain_scene(count, options),
+                      how, bodies, contacts);
   }
   bodies.commit();
   contacts.commit();

@@ -127,11 +127,12 @@ def impulse_error(J, reference):
 
 def generate(kind, n, *, seed=1, model="rigid", friction=False, shuffle=False, dtype=_np.float32):
     """The scenes of ``collide gen``: ``kind`` "pairs" (n independent pairs,
-    2n bodies), "debris" (n contacts on shared bodies) or "pile" (n x n x n
+    2n bodies), "debris" (n contacts on shared bodies), "pile" (n x n x n
     boxes on a lattice, each touching its neighbours, the bottom layer on an
     immovable ground; contacts in broadphase cell order, or in a seeded random
-    order with ``shuffle=True``). Returns ``(Bodies, Contacts)`` over new
-    arrays."""
+    order with ``shuffle=True``) or "chain" (n + 1 boxes in a staircase, each
+    touching the next, n contacts in chain order, which run one after
+    another). Returns ``(Bodies, Contacts)`` over new arrays."""
     return _collide.generate(kind, n, seed=seed, model=model, friction=friction, shuffle=shuffle, dtype=dtype)
 
 

@@ -164,7 +164,7 @@ def solve(
 def reference_solve(bodies: AnyBodies, contacts: Contacts) -> Reference: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
 def generate(
-    kind: Literal["pairs", "debris", "pile"],
+    kind: Literal["pairs", "debris", "pile", "chain"],
     n: int,
     *,
     seed: int = 1,

@@ -95,8 +95,8 @@ namespace {
 py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
                       bool friction, bool shuffle, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris" && kind != "pile") {
-    throw py::value_error("kind must be 'pairs', 'debris' or 'pile', got '" + kind + "'");
+  if (kind != "pairs" && kind != "debris" && kind != "pile" && kind != "chain") {
+    throw py::value_error("kind must be 'pairs', 'debris', 'pile' or 'chain', got '" + kind + "'");
   }
   if (kind == "pile") {
     // As `collide gen --pile S`: n boxes per side.
@@ -120,7 +120,8 @@ py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed
       py::gil_scoped_release release;
       s = kind == "pairs"    ? generate_pairs<T>(n, o)
           : kind == "debris" ? generate_debris<T>(n, o)
-                             : generate_pile<T>(n, o);
+          : kind == "pile"   ? generate_pile<T>(n, o)
+                             : generate_chain<T>(n, o);
     }
     return scene_objects<T>(std::as_const(s.bodies).view(), s.contacts.view(), d);
   });

@@ -601,7 +601,7 @@ TEST_F(CliTest, ForcedParticleRefusedWhereTheRotationMatters) {
 
 TEST_F(CliTest, GenSameSeedSameBytesDifferentSeedDifferentBytes) {
   for (const auto& [kind, n] : std::vector<std::pair<std::string, std::string>>{
-           {"--pairs", "20000"}, {"--debris", "20000"}, {"--pile", "20"}}) {
+           {"--pairs", "20000"}, {"--debris", "20000"}, {"--pile", "20"}, {"--chain", "20000"}}) {
     ASSERT_EQ(run({"gen", kind, n, "--out", path("a").string(), "--seed", "7", "--threads", "1"}).exit_code, 0);
     ASSERT_EQ(run({"gen", kind, n, "--out", path("b").string(), "--seed", "7"}).exit_code, 0);
     ASSERT_EQ(run({"gen", kind, n, "--out", path("c").string(), "--seed", "8"}).exit_code, 0);
@@ -662,6 +662,43 @@ std::vector<std::string> sorted_rows(const std::string& text) {
   while (std::getline(in, line)) rows.push_back(line);
   std::sort(rows.begin(), rows.end());
   return rows;
+}
+
+TEST_F(CliTest, GenChainWritesTheLibrarysChain) {
+  // --chain N: N contacts over N + 1 boxes, the values of generate.hpp's
+  // chain exactly, each contact sharing a box with the one before.
+  const std::size_t n = 300;
+  const RunResult r = run({"gen", "--chain", "300", "--out", dir_.string(), "--seed", "5", "--friction"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto table = collide::read_bodies<double>(path("bodies.csv").string());
+  ASSERT_EQ(table.size(), collide::chain_body_count(n));
+  ASSERT_EQ(table.size(), n + 1);
+  const auto contacts = collide::read_contacts<double>(path("contacts.csv").string(), table.size());
+  ASSERT_EQ(contacts.size(), n);
+  collide::GenerateOptions options;
+  options.seed = 5;
+  options.friction = true;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    collide::BodyRecord<double> body;
+    collide::draw_chain_body(options, n, i, body);
+    const double expected[17] = {body.m,    body.I[0], body.I[1], body.I[2], body.q[0], body.q[1],
+                                 body.q[2], body.q[3], body.p[0], body.p[1], body.p[2], body.v[0],
+                                 body.v[1], body.v[2], body.w[0], body.w[1], body.w[2]};
+    for (std::size_t k = 0; k < 17; ++k) ASSERT_EQ(table.column[k][i], expected[k]) << "body " << i << " column " << k;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    collide::ContactRecord<double> c;
+    collide::draw_chain_contact(options, n, k, c);
+    const auto got = contacts.record(k);
+    ASSERT_EQ(got.a, k);
+    ASSERT_EQ(got.b, k + 1);
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_EQ(got.c[j], c.c[j]) << k;
+      ASSERT_EQ(got.n[j], c.n[j]) << k;
+    }
+    ASSERT_EQ(got.e, c.e) << k;
+    ASSERT_EQ(got.mu, c.mu) << k;
+  }
 }
 
 TEST_F(CliTest, GenPileWritesTheLibrarysPile) {
@@ -732,7 +769,8 @@ TEST_F(CliTest, GenPileUsageErrorsSayWhy) {
       {{"gen", "--pile", "many", "--out", path("g").string()}, "option '--pile' needs a non-negative integer"},
       {{"gen", "--pile", "--out", path("g").string()}, "option '--pile' needs a value"},
       {{"gen", "--pile", "3", "--debris", "10", "--out", path("g").string()},
-       "give exactly one of --pairs N, --debris N and --pile S"},
+       "give exactly one of --pairs N, --debris N, --pile S and --chain N"},
+      {{"gen", "--chain", "10", "--shuffle", "--out", path("g").string()}, "--shuffle is for --pile"},
       {{"gen", "--pairs", "10", "--shuffle", "--out", path("g").string()}, "--shuffle is for --pile"},
       {{"gen", "--debris", "10", "--shuffle", "--out", path("g").string()}, "--shuffle is for --pile"},
       {{"gen", "--pile", "3", "--shuffle=yes", "--out", path("g").string()}, "takes no value"},

@@ -18,7 +18,7 @@ def read_impulses(path, dtype):
 
 @pytest.mark.parametrize("dtype,precision", [(np.float32, "float"), (np.float64, "double")])
 @pytest.mark.parametrize("scene", [["--pairs", "3000"], ["--debris", "3000", "--friction"],
-                                   ["--pile", "9", "--shuffle", "--friction"]])
+                                   ["--pile", "9", "--shuffle", "--friction"], ["--chain", "2000"]])
 def test_bitwise_equal_to_cli(cli, workdir, dtype, precision, scene):
     run([cli, "gen", *scene, "--out", workdir, "--seed", "7"])
     b_csv, c_csv = os.path.join(workdir, "bodies.csv"), os.path.join(workdir, "contacts.csv")
@@ -211,6 +211,21 @@ def test_report_hard_rows():
         collide.report_hard(n=0)
     with pytest.raises(ValueError, match="runs"):
         collide.report_hard(runs=0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_generate_chain(dtype):
+    bodies, contacts = collide.generate("chain", 500, dtype=dtype)
+    assert len(bodies) == 501 and len(contacts) == 500
+    # Each contact joins box k and box k + 1: one batch per contact.
+    assert np.array_equal(contacts.a, np.arange(500)) and np.array_equal(contacts.b, np.arange(1, 501))
+    J, stats = collide.solve(bodies, contacts)
+    assert stats["batches"] == 500 and stats["impacts"] > 0
+    ref_bodies, ref_contacts = collide.generate("chain", 500, dtype=dtype)
+    J_scalar, _ = collide.solve(ref_bodies, ref_contacts, path="scalar")
+    assert np.array_equal(J.view(np.uint8), J_scalar.view(np.uint8))
+    with pytest.raises(ValueError, match="shuffle"):
+        collide.generate("chain", 10, shuffle=True)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
