@@ -138,9 +138,10 @@ class Schedule {
   std::size_t body_count_ = 0;
   std::size_t largest_batch_ = 0;
   std::size_t conflicts_ = 0;
-  /// Passes 3 and 4 of schedule.cpp: groups contacts by level.
+  /// Passes 3 and 4 of schedule.cpp: groups contacts by level. `runs`: the
+  /// level windows set a floor, so most neighbours share a level.
   template <class Level>
-  void sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers);
+  void sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers, bool runs);
 
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> level_;      // scratch: batch of each contact (bytes while batches < 254)
