@@ -29,6 +29,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <ostream>
 #include <queue>
 #include <random>
 #include <stdexcept>
@@ -427,22 +428,39 @@ void expect_islands_solve_like_the_whole(Model model, Accuracy accuracy, bool fr
   }
 }
 
-class IslandSolves : public ::testing::TestWithParam<std::tuple<Model, Accuracy, bool>> {};
+/// One configuration of the island-by-island solve.
+struct IslandCase {
+  Model model;
+  Accuracy accuracy;
+  bool friction;
+};
 
-TEST_P(IslandSolves, EachIslandAloneGivesTheWholeSolvesBits) {
-  const auto [model, accuracy, friction] = GetParam();
-  expect_islands_solve_like_the_whole<float>(model, accuracy, friction);
-  expect_islands_solve_like_the_whole<double>(model, accuracy, friction);
+std::string describe(const IslandCase& c) {
+  return std::string(to_string(c.model)) + "_" + to_string(c.accuracy) + (c.friction ? "_friction" : "_frictionless");
 }
 
-INSTANTIATE_TEST_SUITE_P(AllModels, IslandSolves,
-                         ::testing::Combine(::testing::Values(Model::particle, Model::sphere, Model::rigid),
-                                            ::testing::Values(Accuracy::fast, Accuracy::accurate), ::testing::Bool()),
-                         [](const auto& info) {
-                           return std::string(to_string(std::get<0>(info.param))) + "_" +
-                                  to_string(std::get<1>(info.param)) +
-                                  (std::get<2>(info.param) ? "_friction" : "_frictionless");
-                         });
+void PrintTo(const IslandCase& c, std::ostream* os) { *os << describe(c); }
+
+std::vector<IslandCase> island_cases() {
+  std::vector<IslandCase> cases;
+  for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
+    for (const Accuracy accuracy : {Accuracy::fast, Accuracy::accurate}) {
+      for (const bool friction : {false, true}) cases.push_back({model, accuracy, friction});
+    }
+  }
+  return cases;
+}
+
+class IslandSolves : public ::testing::TestWithParam<IslandCase> {};
+
+TEST_P(IslandSolves, EachIslandAloneGivesTheWholeSolvesBits) {
+  const IslandCase c = GetParam();
+  expect_islands_solve_like_the_whole<float>(c.model, c.accuracy, c.friction);
+  expect_islands_solve_like_the_whole<double>(c.model, c.accuracy, c.friction);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModels, IslandSolves, ::testing::ValuesIn(island_cases()),
+                         [](const auto& info) { return describe(info.param); });
 
 TEST(Islands, PackedRecordsGiveTheIslandsOfTheirView) {
   for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
