@@ -34,6 +34,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cassert>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -196,6 +197,7 @@ Islands islands_strided(const ContactView<T>& contacts, std::size_t body_count, 
   });
   for (std::size_t c = 0; c < contact_chunks.count; ++c) chunk_first[c + 1] += chunk_first[c];
   const std::size_t island_count = chunk_first[contact_chunks.count];
+  assert(island_count <= m && (m == 0 || island_count > 0));
   contact_chunks.run([&](std::size_t c, std::size_t begin, std::size_t end) {
     std::uint32_t next = chunk_first[c];
     for (std::size_t k = begin; k < end; ++k) {
@@ -216,6 +218,7 @@ Islands islands_strided(const ContactView<T>& contacts, std::size_t body_count, 
     std::size_t k = begin;
     while (k < end) {
       const std::uint32_t l = label[k];
+      assert(l < island_count);
       const std::size_t run_start = k;
       while (k < end && label[k] == l) ++k;
       Ref(sizes[l]).fetch_add(static_cast<std::uint32_t>(k - run_start), std::memory_order_relaxed);
@@ -227,6 +230,8 @@ Islands islands_strided(const ContactView<T>& contacts, std::size_t body_count, 
       parent[i] = r == kNone || first[r] == kNone ? kNone : label[first[r]];
     }
   });
+  // Every contact counted once, in one island.
+  assert(std::accumulate(sizes, sizes + island_count, std::size_t{0}) == m);
   if (island_count > 0) {
     const std::uint32_t* const largest = std::max_element(sizes, sizes + island_count);
     out.largest = *largest;

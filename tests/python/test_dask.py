@@ -149,6 +149,26 @@ def test_scene_files_same_bytes_written_in_place(client, tmp_path, model, dtype,
                    expected32)
 
 
+def test_workers_map_the_members_of_scene_files(tmp_path):
+    from collide.dask._files import npz_columns
+
+    bodies, contacts = collide.generate("debris", 500, friction=True, dtype=np.float32)
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, bodies, contacts)
+    np.savez(tmp_path / "numpy.npz", x=np.arange(7, dtype=np.int64), empty=np.zeros(0))
+    for path in (bp, cp, tmp_path / "numpy.npz"):
+        columns = npz_columns(path)
+        with np.load(path) as z:
+            assert sorted(columns) == sorted(z.files)
+            for name in z.files:
+                assert columns[name].dtype == z[name].dtype and columns[name].tobytes() == z[name].tobytes(), name
+                assert isinstance(columns[name], np.memmap) or columns[name].size == 0
+                assert not columns[name].flags.writeable or columns[name].size == 0
+    np.savez_compressed(tmp_path / "z.npz", x=np.arange(7))
+    with pytest.raises(ValueError, match=r"z\.npz: member 'x\.npy' is compressed"):
+        npz_columns(tmp_path / "z.npz")
+
+
 def test_partition_islands_is_a_balanced_deterministic_greedy():
     # Equal islands: consecutive runs of equal size.
     parts = cd.partition_islands(np.full(100, 5), 4)
