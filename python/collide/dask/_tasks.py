@@ -109,15 +109,15 @@ def read_part(part):
     dtype = np.dtype(part["dtype"])
     rows = contact_rows(part)
     cols = npz_columns(part["contacts_path"])
-    a = take(cols["a"], rows).astype(np.uint32)
-    b = take(cols["b"], rows).astype(np.uint32)
+    a = take(cols["a"], rows).astype(np.uint32, copy=False)
+    b = take(cols["b"], rows).astype(np.uint32, copy=False)
     ids, la, lb = local_bodies(a, b, part["body_count"])
-    real = {k: take(cols[k], rows).astype(dtype) for k in CONTACT_REALS}
+    real = {k: take(cols[k], rows).astype(dtype, copy=False) for k in CONTACT_REALS}
     contacts = collide.Contacts(la, lb, np.stack([real["cx"], real["cy"], real["cz"]]),
                                 np.stack([real["nx"], real["ny"], real["nz"]]), real["e"],
                                 mu=real["mu"] if part["friction"] else None)
     bcols = npz_columns(part["bodies_path"])
-    x = [take(bcols[k], ids).astype(dtype) for k in BODY_COLUMNS]
+    x = [take(bcols[k], ids).astype(dtype, copy=False) for k in BODY_COLUMNS]
     # The inverses as collide.load computes them (the readers' own code).
     bodies = collide.from_physical(x[0], np.stack(x[1:4]), np.stack(x[4:8]), np.stack(x[8:11]), np.stack(x[11:14]),
                                    np.stack(x[14:17]), dtype=dtype)
