@@ -18,8 +18,9 @@
 #      stops the target with a non-zero exit; the input is kept under
 #      build-asan/fuzz-artifacts/.
 #   3. TSan: a Clang build of only what the parallel kernel tests need
-#      (determinism, schedule, the caller's-arena solver, the shared-body hard
-#      cases) and ctest on those. TBB's hand-overs reach TSan through the ITT
+#      (determinism, schedule, the islands' lock-free union-find, the
+#      caller's-arena solver, the shared-body hard cases) and ctest on those.
+#      TBB's hand-overs reach TSan through the ITT
 #      bridge (tests/tsan/itt_tsan_bridge.cpp); tests/tsan/tbb.supp hides
 #      TBB's own task-memory recycling and nothing else. Last, race_canary
 #      must produce a TSan report in the kernel: proof that the bridge and the
@@ -84,14 +85,14 @@ tsan="$root/build-tsan"
 stage "TSan build"
 cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" -DCOLLIDE_SANITIZE=thread \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
-cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_solver_arena test_hard_shared \
-  collide_itt_tsan collide_race_canary
+cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_islands test_solver_arena \
+  test_hard_shared collide_itt_tsan collide_race_canary
 stage "TSan tests"
 export INTEL_LIBITTNOTIFY64="$tsan/libcollide_itt_tsan.so"
 export INTEL_ITTNOTIFY_GROUPS=sync
 export TSAN_OPTIONS="suppressions=$root/tests/tsan/tbb.supp"
 ctest --test-dir "$tsan" --output-on-failure -j"$jobs" \
-  -R '^(Scenes/Determinism|Schedule|ScheduleOrder|SolverArena|HardShared)\.'
+  -R '^(Scenes/Determinism|Schedule|ScheduleOrder|Islands|AllModels/IslandSolves|SolverArena|HardShared)\.'
 # The negative control: TSan must see the canary's race, in the kernel.
 set +e
 "$tsan/collide_race_canary" >"$tsan/race_canary.log" 2>&1

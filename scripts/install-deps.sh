@@ -9,13 +9,17 @@ set -euo pipefail
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
 # tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
 # no network (venv, setuptools, pip).
+# python3-dask, python3-distributed, python3-pandas: collide.dask (python/collide/dask),
+# the solve split across Dask workers by islands and solve_scenes' table, and its
+# tests on a LocalCluster (tests/python/test_dask.py); `import collide` does not need them.
 # ccache: scripts/build.sh and setup.py compile through it when present, so the
 # pip install test reuses the normal build's objects (python/CMakeLists.txt).
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
 # scripts/ci-sanitizers.sh.
 packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev libdeflate-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
   clang-14 libclang-rt-14-dev
-  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip)
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip
+  python3-dask python3-distributed python3-pandas)
 
 missing=()
 for p in "${packages[@]}"; do

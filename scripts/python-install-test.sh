@@ -1,7 +1,8 @@
 #!/bin/sh
 # The install step of the README for Python, as a test: a fresh venv with
 # the system site packages (numpy), `pip install --no-build-isolation` of the
-# checkout with no network, then import collide and solve a scene.
+# checkout with no network, then import collide and solve a scene, import
+# collide.dask and run its console script.
 # usage: python-install-test.sh SOURCE_DIR WORK_DIR   (PYTHON: the interpreter, default /usr/bin/python3)
 set -eu
 src=$1
@@ -28,4 +29,9 @@ J, stats = collide.solve(bodies, contacts)
 err = collide.impulse_error(J, ref)
 assert stats["collisions"] == 10000 and float(err.max()) <= collide.error_bound_eps
 print("import collide and solve: ok,", stats["isa"], stats["collisions_per_second"], "collisions/s")
+import collide.dask
+assert collide.dask.__file__.startswith(__import__("sys").prefix), collide.dask.__file__
 PY
+# The command of collide.dask, installed as a console script.
+"$work/venv/bin/collide-dask" --help >/dev/null
+echo "collide-dask: ok"

@@ -55,12 +55,15 @@
 #include <string>
 #include <utility>
 
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/partitioner.h>
 #include <oneapi/tbb/task_arena.h>
+
+#include "chunks.hpp"
 
 namespace collide {
 namespace {
+
+using detail::chunk_count;
+using detail::for_each_chunk;
 
 /// The wide body-table sentinel; contact counts stay below it.
 constexpr std::uint32_t kImmovable = std::numeric_limits<std::uint32_t>::max();
@@ -69,10 +72,6 @@ constexpr std::uint32_t kImmovable = std::numeric_limits<std::uint32_t>::max();
 /// debris scene at 2M and 4M contacts: 8 leaves misses exposed, 16 to 64 are
 /// within 5% of each other.
 constexpr std::size_t kPrefetchDistance = 16;
-
-/// Fewest contacts (or bodies) per parallel chunk: below that, starting a
-/// task costs more than the chunk.
-constexpr std::size_t kMinChunk = std::size_t{1} << 15;
 
 /// Per-chunk level counts may take at most one 4-byte count per this many
 /// contacts (1 B per contact), which keeps a scene of many small batches (a
@@ -87,25 +86,6 @@ inline void prefetch_for_write(const void* p) {
 #endif
 }
 
-/// Chunks for `items` items on `threads` threads: at least one, at most one
-/// per kMinChunk items.
-std::size_t chunk_count(std::size_t items, std::size_t threads) {
-  return std::max<std::size_t>(1, std::min(threads, items / kMinChunk));
-}
-
-/// Runs f(chunk, begin, end) over `chunks` equal slices of [0, items), in
-/// parallel in the calling thread's arena when there is more than one.
-template <class F>
-void for_each_chunk(std::size_t items, std::size_t chunks, const F& f) {
-  const auto begin = [&](std::size_t c) { return items / chunks * c + std::min(c, items % chunks); };
-  if (chunks == 1) {
-    f(std::size_t{0}, std::size_t{0}, items);
-    return;
-  }
-  tbb::parallel_for(
-      std::size_t{0}, chunks, [&](std::size_t c) { f(c, begin(c), begin(c + 1)); }, tbb::simple_partitioner());
-}
-
 /// The body-table word of a body that never conflicts (inverse mass 0). No
 /// level + 1 equals it: a narrow pass stops before (see assign_levels), and a
 /// wide level is at most contacts - 1 < 2^32 - 2.
@@ -116,7 +96,9 @@ constexpr Word kImmovableWord = std::numeric_limits<Word>::max();
 /// inv_mass[i * stride] (1 for SoA views, the record size for packed ones).
 template <class Word, class T>
 void fill_body_table(const T* inv_mass, std::size_t stride, std::size_t begin, std::size_t end, Word* next) {
-  for (std::size_t i = begin; i < end; ++i) next[i] = inv_mass[i * stride] != T(0) ? Word{0} : kImmovableWord<Word>;
+  for (std::size_t i = begin; i < end; ++i) {
+    next[i] = is_immovable(inv_mass[i * stride]) ? kImmovableWord<Word> : Word{0};
+  }
 }
 
 /// Throws the std::invalid_argument for the first contact of [k, end) with

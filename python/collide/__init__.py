@@ -26,6 +26,7 @@ from . import _collide
 from ._collide import (
     Bodies,
     Contacts,
+    Islands,
     MappedFile,
     PackedBodies,
     Reference,
@@ -39,6 +40,7 @@ from ._collide import (
 __all__ = [
     "Bodies",
     "Contacts",
+    "Islands",
     "MappedFile",
     "PackedBodies",
     "Reference",
@@ -48,8 +50,10 @@ __all__ = [
     "error_bound_eps",
     "error_target_eps",
     "from_physical",
+    "conservation_drift",
     "generate",
     "impulse_error",
+    "islands",
     "load",
     "pack",
     "packed_dtype",
@@ -123,6 +127,37 @@ def impulse_error(J, reference):
     eps(J.dtype) * impulse_scale (what ``collide solve --check`` bounds by
     ``error_bound_eps``). NaN for a NaN impulse."""
     return _collide.impulse_error(J, reference)
+
+
+def conservation_drift(bodies, reference):
+    """How far the momenta and energy of ``bodies`` after a solve are from
+    the reference's after the same contacts (the columns of ``collide
+    report``): a dict with ``momentum_drift`` (|P - Pref| / sum m|v|),
+    ``angular_momentum_drift`` (|L - Lref| / sum (|p x m v| + |I w|)) and
+    ``energy_drift`` (|E - Eref| / E), the scales taken before the solve.
+    ``reference`` is :func:`reference_solve` of the same bodies before the
+    solve; totals are summed in long double over movable bodies."""
+    if isinstance(bodies, PackedBodies):
+        bodies = bodies.unpack()
+    return _collide.conservation_drift(bodies, reference)
+
+
+def islands(bodies, contacts, *, threads=0):
+    """The islands of a scene: the groups of contacts joined by shared
+    movable bodies (immovable bodies, inverse mass 0, join nothing; a contact
+    between two immovable bodies is an island of its own). Solving each
+    island alone, its contacts in input order, gives the same bits as one
+    solve of the whole scene. Returns an :class:`Islands` whose NumPy arrays
+    (read-only uint32 views, no copy) are ``labels`` (M,), the island of each
+    contact, islands numbered in the order of their first contact;
+    ``body_labels`` (N,), the island of each body or ``Islands.NONE``
+    (immovable, or without contacts); ``sizes``, the contacts of each island;
+    and ``count``, ``largest`` (contacts of the largest island) and
+    ``largest_label``. Computed by the library in parallel on ``threads``
+    threads (0: all), the same labels for any number. A bad index raises
+    ValueError naming the contact; only indices and inverse masses are
+    read."""
+    return _collide.islands(bodies, contacts, threads=threads)
 
 
 def generate(kind, n, *, seed=1, model="rigid", friction=False, shuffle=False, dtype=_np.float32):

@@ -161,7 +161,21 @@ def solve(
     check: bool = True,
     impacts: bool = True,
 ) -> tuple[FloatArray, dict[str, Any]]: ...
+class Islands:
+    """The islands of a scene: read-only uint32 views of the library's result."""
+
+    NONE: int
+    labels: npt.NDArray[np.uint32]
+    body_labels: npt.NDArray[np.uint32]
+    sizes: npt.NDArray[np.uint32]
+    count: int
+    largest: int
+    largest_label: int
+    def __len__(self) -> int: ...
+
+def islands(bodies: AnyBodies, contacts: Contacts, *, threads: int = 0) -> Islands: ...
 def reference_solve(bodies: AnyBodies, contacts: Contacts) -> Reference: ...
+def conservation_drift(bodies: AnyBodies, reference: Reference) -> dict[str, float]: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
 def generate(
     kind: Literal["pairs", "debris", "pile", "chain"],

@@ -20,8 +20,9 @@
 //   reference). The ndarrays stay referenced by the Bodies and Contacts
 //   objects (and the call's arguments) meanwhile.
 // * The statistics dict is collide::solve_record (collide/eval/check.hpp),
-//   the record `collide solve --stats` prints, and the error per contact is
-//   collide::impulse_errors_eps, what `--check` summarises.
+//   the record `collide solve --stats` prints, the error per contact is
+//   collide::impulse_errors_eps, what `--check` summarises, and the
+//   conservation drifts are collide::conservation_drift, the report's.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -30,11 +31,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
 #include "bindings.hpp"
 #include "collide/eval/check.hpp"
+#include "collide/eval/conservation.hpp"
 #include "collide/eval/error_bound.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
@@ -198,6 +201,9 @@ struct Reference {
   ImpulseBuffer<long double> impulses;
   std::vector<ReferenceContact<long double>> diagnostics;
   BodyBuffer<long double> after;
+  /// The momenta and energy before the reference solve and after it
+  /// (collide/eval/conservation.hpp), what conservation_drift compares with.
+  MomentumTotals before_totals, after_totals;
   Dtype dtype = Dtype::f64;
 
   py::array j_array() const {
@@ -241,7 +247,9 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
     const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
     r->impulses.resize(contacts.count);
     r->diagnostics.resize(contacts.count);
+    r->before_totals = momentum_totals<long double>(std::as_const(r->after).view());
     reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data());
+    r->after_totals = momentum_totals<long double>(std::as_const(r->after).view());
     return r;
   });
 }
@@ -260,6 +268,26 @@ py::array impulse_error_py(const py::object& j_in, const Reference& ref) {
     std::copy(errors.begin(), errors.end(), out.mutable_data());
     return out;
   });
+}
+
+/// The conservation drifts of bodies solved from the state the reference
+/// started from (collide/eval/conservation.hpp; the report's columns).
+py::dict conservation_drift_py(const Bodies& bodies, const Reference& ref) {
+  if (bodies.count != ref.after.size()) {
+    throw py::value_error("conservation_drift: the bodies are " + std::to_string(bodies.count) + ", the reference's " +
+                          std::to_string(ref.after.size()));
+  }
+  const ConservationDrift drift = with_dtype(bodies.dtype, [&](auto tag) {
+    using T = decltype(tag);
+    const BodyView<T> bv = bodies.view<T>();
+    py::gil_scoped_release release;
+    return conservation_drift(ref.before_totals, ref.after_totals, momentum_totals<T>(const_view(bv)));
+  });
+  py::dict d;
+  d["momentum_drift"] = drift.momentum;
+  d["angular_momentum_drift"] = drift.angular_momentum;
+  d["energy_drift"] = drift.energy;
+  return d;
 }
 
 }  // namespace
@@ -296,6 +324,7 @@ void register_solve(py::module_& m) {
 
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"));
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
+  m.def("conservation_drift", &conservation_drift_py, py::arg("bodies"), py::arg("reference"));
   m.attr("accurate_error_ulps") = kAccurateErrorUlps;
   m.attr("error_target_eps") = kImpulseErrorTargetEps;
   m.attr("error_bound_eps") = kImpulseErrorBoundEps;

@@ -6,7 +6,8 @@
 // * Each topic is a file of its own: the NumPy array checks and views
 //   (arrays.hpp), Bodies and Contacts and the scenes made from Python
 //   (bind_scene.cpp), packed records (bind_packed.cpp), solving, schedules,
-//   the reference and the instruction sets (bind_solve.cpp), scene files
+//   the reference and the instruction sets (bind_solve.cpp), the islands of
+//   a scene (bind_islands.cpp), scene files
 //   (bind_files.cpp), the report (bind_report.cpp). The collide package
 //   (python/collide/__init__.py) gives the public functions their Python
 //   signatures and documentation over these.
@@ -29,6 +30,7 @@ PYBIND11_MODULE(_collide, m) {
   register_scene(m);
   register_packed(m);
   register_solve(m);
+  register_islands(m);
   register_files(m);
   register_report(m);
 }

@@ -166,10 +166,17 @@ class BodyBuffer {
   std::vector<T> px_, py_, pz_, vx_, vy_, vz_, wx_, wy_, wz_;
 };
 
+/// True for the inverse mass of an immovable body: 0, whatever the moments
+/// say. The one rule the kernels, the schedule and the islands apply.
+template <class T>
+[[nodiscard]] constexpr bool is_immovable(T inv_mass) {
+  return inv_mass == T(0);
+}
+
 /// True when the view's body i is immovable (inverse mass 0).
 template <class T>
 [[nodiscard]] inline bool is_immovable(const BodyView<T>& bodies, std::size_t i) {
-  return bodies.inv_mass[i] == T(0);
+  return is_immovable(bodies.inv_mass[i]);
 }
 
 extern template class BodyBuffer<float>;

@@ -10,6 +10,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/eval/conservation.hpp"
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
 #include "report.hpp"
@@ -20,25 +21,11 @@ namespace collide::report_detail {
 // Error against the reference (measure.cpp).
 // ---------------------------------------------------------------------------
 
-/// Linear momentum, angular momentum about the origin (orbital p x m v plus
-/// spin), kinetic energy, and the scales the drifts are divided by. Locked
-/// axes (inverse moment 0) are left out of the spin terms: their spin never
-/// changes, and their moment is infinite.
-struct Totals {
-  long double p[3] = {0, 0, 0};
-  long double l[3] = {0, 0, 0};
-  long double energy = 0;
-  long double p_scale = 0;  ///< sum m |v|
-  long double l_scale = 0;  ///< sum |p x m v| + |I w|
-};
-template <class T>
-Totals body_totals(const BodyView<const T>& bodies);
-
 /// The long double reference for one error sample.
 struct ReferenceResult {
   ImpulseBuffer<long double> impulses;
   std::vector<ReferenceContact<long double>> diagnostics;
-  Totals before, after;
+  MomentumTotals before, after;  ///< collide/eval/conservation.hpp
 };
 /// Solves convert_scene<long double>(sample) with reference_solve<long double>.
 template <class T>

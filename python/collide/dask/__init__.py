@@ -1,0 +1,432 @@
+"""collide.dask: one scene split across Dask workers by its islands, or many
+scenes solved and measured across them.
+
+A scene's islands (:func:`collide.islands`: the groups of contacts joined by
+shared movable bodies) never see each other's results, so each can be solved
+anywhere, and the result is bit for bit that of :func:`collide.solve` on one
+machine. :func:`solve` groups the islands into partitions balanced by contact
+count and solves each partition on a worker with the ordinary solver;
+:func:`solve_scenes` solves many scenes, one task each, and returns a pandas
+table of speed, error and conservation. One island is one sequential chain of
+dependencies: a scene whose largest island holds most of the contacts is
+solved mostly on one worker, and :func:`solve` warns (:class:`IslandWarning`).
+
+Dask (``distributed``) and pandas are imported when a function needs them,
+so ``import collide`` and ``import collide.dask`` work without them.
+docs/distributed.md describes when distribution helps, the API and the
+command (``python -m collide.dask``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+import uuid
+import warnings
+from typing import NamedTuple
+
+import numpy as np
+
+import collide
+
+from ._partition import partition_islands
+from . import _tasks
+
+__all__ = ["GIANT_ISLAND_SHARE", "IslandWarning", "SCENE_COLUMNS", "Solution", "partition_islands", "solve",
+           "solve_scenes"]
+
+#: The share of a scene's contacts in its largest island above which
+#: :func:`solve` warns that distribution cannot help much.
+GIANT_ISLAND_SHARE = 0.5
+
+
+class IslandWarning(UserWarning):
+    """The largest island holds most of the scene's contacts: it is solved on
+    one worker, in input order, whatever the number of workers."""
+
+
+class Solution(NamedTuple):
+    """What :func:`solve` returns. For a scene of arrays, ``v`` and ``w`` are
+    the caller's ``bodies.v`` and ``bodies.w``, updated in place as
+    :func:`collide.solve` updates them; for scene files, read-only maps of
+    the output files ``J.npy``, ``v.npy`` and ``w.npy``."""
+
+    J: np.ndarray
+    v: np.ndarray
+    w: np.ndarray
+    stats: dict
+
+
+def _need(module):
+    """Imports a Dask module (or pandas), or raises ImportError saying what to install."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        raise ImportError(f"collide.dask needs {module.split('.')[0]} (Debian: python3-dask python3-distributed "
+                          f"python3-pandas; pip: dask distributed pandas): {e}") from e
+
+
+@contextlib.contextmanager
+def _connected(client, workers=None):
+    """The client to run on: ``client`` itself, a new Client to a scheduler
+    address, the default client of this process, or a new LocalCluster
+    (``workers`` processes of one thread; all cores by default), closed
+    afterwards."""
+    distributed = _need("distributed")
+    if isinstance(client, distributed.Client):
+        yield client
+        return
+    if isinstance(client, str):
+        with distributed.Client(client) as c:
+            yield c
+        return
+    if client is not None:
+        raise TypeError(f"client must be a distributed.Client, a scheduler address or None, got "
+                        f"{type(client).__name__}")
+    try:
+        yield distributed.default_client()
+        return
+    except ValueError:
+        pass
+    n = workers or os.cpu_count() or 1
+    with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        with distributed.Client(cluster) as c:
+            yield c
+
+
+def _wait(futures, progress, what):
+    """Waits for every future and returns their results in order. With
+    ``progress``, a bar on stderr (dask.distributed.progress) when stderr is
+    a terminal, else a line per finished task."""
+    distributed = _need("distributed")
+    if progress and futures:
+        if sys.stderr.isatty():
+            with contextlib.redirect_stdout(sys.stderr):
+                distributed.progress(futures)
+            print(file=sys.stderr)
+        else:
+            for done, _ in enumerate(distributed.as_completed(futures), start=1):
+                print(f"collide-dask: {done}/{len(futures)} {what} done", file=sys.stderr, flush=True)
+    return [f.result() for f in futures]
+
+
+def _options(model, accuracy, threads, isa, sample=0):
+    if accuracy not in ("fast", "accurate"):
+        raise ValueError(f"accuracy must be 'fast' or 'accurate', got {accuracy!r}")
+    if model not in ("auto", "rigid", "sphere", "particle"):
+        raise ValueError(f"model must be 'auto', 'rigid', 'sphere' or 'particle', got {model!r}")
+    if int(threads) < 0:
+        raise ValueError(f"threads must be >= 0, got {threads}")
+    return {"model": model, "accuracy": accuracy, "threads": int(threads), "isa": isa, "sample": int(sample)}
+
+
+def _scene_model(bodies, contacts, model):
+    """The model the whole scene runs, after every value of it is checked by
+    the library's validate() (ValueError naming the array and the element):
+    the model collide.solve would run. Partitions run this model, not their
+    own cheapest, which could differ from the whole scene's."""
+    chosen = collide._collide.choose_model(bodies, contacts)
+    if model == "auto":
+        return chosen
+    misfit = collide._collide.model_misfit(bodies, contacts, model)
+    if misfit:
+        raise ValueError(f"model '{model}' does not fit the scene: {misfit}")
+    return model
+
+
+def _prepare(bodies, contacts, options):
+    """What the client does before any task: checks the scene and chooses
+    its model, computes its islands and warns about a giant one. Returns the
+    options of the tasks, the islands, their figures and their time."""
+    task = dict(options, model=_scene_model(bodies, contacts, options["model"]))
+    t = time.perf_counter()
+    isl = collide.islands(bodies, contacts)
+    islands_seconds = time.perf_counter() - t
+    m = len(contacts)
+    share = isl.largest / m if m else 0.0
+    figures = {"islands": isl.count, "largest_island": isl.largest, "largest_island_share": share}
+    _warn_if_giant(figures, m, stacklevel=5)
+    return task, isl, figures, islands_seconds
+
+
+def _warn_if_giant(figures, contacts, stacklevel):
+    if contacts and figures["largest_island_share"] > GIANT_ISLAND_SHARE:
+        warnings.warn(IslandWarning(
+            f"collide.dask.solve: the largest island holds {figures['largest_island']:,} of {contacts:,} contacts "
+            f"({100 * figures['largest_island_share']:.0f}%; {figures['islands']:,} islands): it is solved on one "
+            "worker, in input order, so distributing this scene gains little"), stacklevel=stacklevel)
+
+
+def _partitions(isl, requested, client):
+    """The contacts grouped by partition, ascending inside each (the scene's
+    order), and the contacts of each partition and where its group ends:
+    ``(order, counts, ends)``."""
+    p = requested if requested is not None else max(1, sum(client.nthreads().values()))
+    if int(p) < 1:
+        raise ValueError(f"partitions must be >= 1, got {p}")
+    island_part = partition_islands(isl.sizes, int(p))
+    used = int(island_part.max()) + 1 if len(island_part) else 1
+    # Small integers, so that NumPy's stable sort of them is a radix sort.
+    dtype = np.uint8 if used <= 256 else np.uint16 if used <= 65536 else np.uint32
+    contact_part = island_part.astype(dtype)[isl.labels]
+    counts = np.bincount(contact_part, minlength=used)
+    return np.argsort(contact_part, kind="stable"), counts, np.cumsum(counts)
+
+
+def _is_scene_files(scene):
+    return isinstance(scene, (tuple, list)) and len(scene) == 2 and all(
+        isinstance(x, (str, os.PathLike)) for x in scene)
+
+
+def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", dtype=None, threads=1, isa=None,
+          out_dir=None, workers=None, progress=False):
+    """Solves one scene on Dask workers, island by island; the same bytes as
+    :func:`collide.solve` on one machine. Returns a :class:`Solution` ``(J,
+    v, w, stats)``.
+
+    ``scene`` is ``(bodies, contacts)``, either :class:`collide.Bodies` and
+    :class:`collide.Contacts` (their ``v`` and ``w`` updated in place, as
+    collide.solve does; the partitions travel to the workers through the
+    scheduler), or the paths of a binary scene file pair (``.npz``, what
+    :func:`collide.save` writes) on storage every worker can read. For files
+    the client checks the whole scene (:func:`collide.load`) and computes
+    its islands; each worker maps the files and reads only its partition's
+    rows, and writes its J and its movable bodies' v and w in place into
+    ``out_dir``'s ``J.npy`` (3, M), ``v.npy`` and ``w.npy`` (3, N), which the
+    client preallocates (v and w hold the input's for bodies no contact
+    moves) and renames into place once every partition is done: bodies and
+    contacts never travel through the scheduler. ``dtype`` (files only)
+    converts, as collide.load does; default: the file's precision.
+
+    The islands are grouped into ``partitions`` partitions (default: the
+    cluster's threads) balanced by contact count (:func:`partition_islands`);
+    the grouping never changes the result. Each partition runs
+    :func:`collide.solve` with the model chosen for the whole scene
+    (``model``: "auto", "rigid", "sphere", "particle"), ``accuracy``
+    ("fast" or "accurate"), ``threads`` solver threads per task (default 1:
+    one per Dask thread) and ``isa``. A task lost with its worker is run
+    again by Dask, writing the same bytes.
+
+    ``client``: a ``distributed.Client``, a scheduler address, or None (the
+    default client of this process, else a LocalCluster of ``workers``
+    single-threaded processes, all cores by default, for this call).
+    ``progress=True`` shows the tasks' progress on stderr.
+
+    Raises TypeError or ValueError for bad input (naming the array and
+    element, or the file, row and column) before anything is written, and
+    warns with :class:`IslandWarning` when the largest island holds more than
+    ``GIANT_ISLAND_SHARE`` of the contacts. ``stats``: collisions, bodies,
+    islands, largest_island, largest_island_share, partitions (their contact
+    counts), model, precision, accuracy, seconds (the whole call),
+    collisions_per_second (collisions / seconds), islands_seconds,
+    kernel_seconds (the partitions' solves, summed), and for files
+    read_seconds (the load and check on the client)."""
+    started = time.perf_counter()
+    options = _options(model, accuracy, threads, isa)
+    if _is_scene_files(scene):
+        if out_dir is None:
+            raise ValueError("collide.dask.solve: scene files need out_dir, where the workers write J, v and w")
+        return _solve_files(scene, client, partitions, options, dtype, os.fspath(out_dir), workers, progress, started)
+    if not (isinstance(scene, (tuple, list)) and len(scene) == 2):
+        raise TypeError("collide.dask.solve: scene must be (bodies, contacts): collide.Bodies and collide.Contacts, "
+                        "or the paths of a binary scene file pair")
+    bodies, contacts = scene
+    if not isinstance(bodies, collide.Bodies) or not isinstance(contacts, collide.Contacts):
+        raise TypeError(f"collide.dask.solve: scene must be (collide.Bodies, collide.Contacts) or two paths, got "
+                        f"({type(bodies).__name__}, {type(contacts).__name__})")
+    if dtype is not None and np.dtype(dtype) != bodies.dtype:
+        raise TypeError(f"collide.dask.solve: dtype={np.dtype(dtype)} but the arrays are {bodies.dtype}: arrays are "
+                        "solved in their own precision")
+    if out_dir is not None:
+        raise ValueError("collide.dask.solve: out_dir is for scene files; arrays are updated in place")
+    return _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started)
+
+
+def _stats(scene_model, precision, collisions, body_count, figures, counts, options, results, started, **extra):
+    """The stats of a distributed solve (see :func:`solve`)."""
+    seconds = time.perf_counter() - started
+    return {"collisions": collisions, "bodies": body_count, **figures, "partitions": [int(c) for c in counts if c],
+            "model": scene_model, "precision": "float" if precision == np.float32 else "double",
+            "accuracy": options["accuracy"], "seconds": seconds,
+            "collisions_per_second": collisions / seconds if seconds > 0 else 0.0,
+            "kernel_seconds": sum(r["kernel_seconds"] for r in results), **extra}
+
+
+def _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started):
+    if bodies.dtype != contacts.dtype:
+        raise TypeError(f"bodies are {bodies.dtype} but contacts are {contacts.dtype}: one precision per solve")
+    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options)
+    with _connected(client, workers) as c:
+        order, counts, ends = _partitions(isl, partitions, c)
+        parts, futures = [], []
+        key = f"collide-dask-part-{uuid.uuid4().hex}"
+        with warnings.catch_warnings():
+            # The partitions go with their tasks, through the scheduler, so
+            # that a task lost with its worker can run again elsewhere.
+            warnings.filterwarnings("ignore", message="Large object of size")
+            for p, count in enumerate(counts):
+                if count == 0:
+                    continue
+                rows = order[ends[p] - count:ends[p]]
+                sub_bodies, sub_contacts, ids = _tasks.sub_scene(bodies, contacts, rows)
+                payload = {"bodies": [getattr(sub_bodies, f) for f in ("inv_mass", "inv_inertia", "q", "p", "v", "w")],
+                           "contacts": [sub_contacts.a, sub_contacts.b, sub_contacts.c, sub_contacts.n, sub_contacts.e,
+                                        sub_contacts.uniform_e, sub_contacts.mu]}
+                parts.append((rows, ids))
+                futures.append(c.submit(_tasks.solve_part_arrays, payload, task, key=f"{key}-{p}", pure=False))
+        results = _wait(futures, progress, "partitions")
+    # Every partition is solved: only now is anything of the caller's written.
+    J = np.empty((3, len(contacts)), dtype=bodies.dtype)
+    for (rows, ids), (j, v, w, movable, _) in zip(parts, results):
+        J[:, rows] = j
+        bodies.v[:, ids[movable]] = v
+        bodies.w[:, ids[movable]] = w
+    stats = _stats(task["model"], bodies.dtype, len(contacts), len(bodies), figures, counts, options,
+                   [r[4] for r in results], started, islands_seconds=islands_seconds)
+    return Solution(J, bodies.v, bodies.w, stats)
+
+
+def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, progress, started):
+    bodies_path, contacts_path = (os.path.abspath(os.fspath(p)) for p in paths)
+    for path in (bodies_path, contacts_path):
+        if not path.endswith(".npz"):
+            raise ValueError(f"collide.dask.solve: {path}: workers map their rows of a binary scene file (.npz); "
+                             "`collide convert` writes one from CSV")
+    t = time.perf_counter()
+    bodies, contacts = collide.load(bodies_path, contacts_path, dtype=dtype)
+    read_seconds = time.perf_counter() - t
+    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options)
+    os.makedirs(out_dir, exist_ok=True)
+    out_dir = os.path.abspath(out_dir)
+    final = {k: os.path.join(out_dir, f"{k}.npy") for k in ("J", "v", "w")}
+    partial = {k: os.path.join(out_dir, f".{k}.npy.partial") for k in final}
+    order_path = os.path.join(out_dir, ".contact-order.npy")
+    n, m = len(bodies), len(contacts)
+    precision = bodies.dtype
+    try:
+        # The outputs, allocated here; v and w start as the input's, so a
+        # body no contact moves (or an immovable one) keeps its values.
+        j = np.lib.format.open_memmap(partial["J"], mode="w+", dtype=precision, shape=(3, m))
+        del j
+        for k in ("v", "w"):
+            out = np.lib.format.open_memmap(partial[k], mode="w+", dtype=precision, shape=(3, n))
+            out[...] = getattr(bodies, k)
+            out.flush()
+            del out
+        common = {"bodies_path": bodies_path, "contacts_path": contacts_path, "body_count": n, "dtype": precision.name,
+                  "friction": contacts.mu is not None, "outputs": partial}
+        with _connected(client, workers) as c:
+            order, counts, ends = _partitions(isl, partitions, c)
+            # Partitions of consecutive contacts (a scene of independent
+            # pairs) are sent as ranges; otherwise the workers read their
+            # rows from an order file beside the outputs.
+            consecutive = all(count == 0 or int(order[e - 1]) - int(order[e - count]) == count - 1
+                              for count, e in zip(counts, ends))
+            if not consecutive:
+                np.save(order_path, order.astype(np.uint32))
+            del bodies, contacts, isl, order
+            key = f"collide-dask-part-{uuid.uuid4().hex}"
+            futures = []
+            for p, count in enumerate(counts):
+                if count == 0:
+                    continue
+                first = int(ends[p] - count)
+                part = dict(common, order=None if consecutive else order_path, first=first, end=first + int(count))
+                futures.append(c.submit(_tasks.solve_part_files, part, task, key=f"{key}-{p}", pure=False))
+            results = _wait(futures, progress, "partitions")
+        for k in final:
+            os.replace(partial[k], final[k])
+    finally:
+        for path in (*partial.values(), order_path):
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(path)
+    stats = _stats(task["model"], precision, m, n, figures, counts, options, results, started,
+                   islands_seconds=islands_seconds, read_seconds=read_seconds, outputs=final)
+    return Solution(*(np.load(final[k], mmap_mode="r") for k in ("J", "v", "w")), stats)
+
+
+#: The columns of the table :func:`solve_scenes` returns, in order.
+SCENE_COLUMNS = ("scene", "model", "precision", "accuracy", "contacts", "islands", "largest_island",
+                 "collisions_per_second", "max_error_eps", "momentum_drift", "angular_momentum_drift", "error_sample")
+
+_SPEC_KEYS = {"kind", "n", "seed", "model", "friction", "shuffle", "dtype", "name", "accuracy"}
+_FILE_KEYS = {"bodies", "contacts", "dtype", "name", "accuracy"}
+
+
+def _entry(i, item):
+    """One solve_scenes entry as a dict a worker can act on, checked here so
+    that a mistake is named before anything runs."""
+    where = f"collide.dask.solve_scenes: scene {i}"
+    if _is_scene_files(item):
+        item = {"bodies": item[0], "contacts": item[1]}
+    if not isinstance(item, dict):
+        raise TypeError(f"{where}: a (bodies, contacts) pair of paths or a dict, got {type(item).__name__}")
+    entry = dict(item)
+    if "dtype" in entry and entry["dtype"] is not None:
+        entry["dtype"] = np.dtype(entry["dtype"]).name
+    if "bodies" in entry:
+        unknown = set(entry) - _FILE_KEYS
+        if unknown or "contacts" not in entry:
+            raise ValueError(f"{where}: a file entry has 'bodies' and 'contacts' (and 'dtype', 'name', 'accuracy'), "
+                             f"got {sorted(entry)}")
+        for k in ("bodies", "contacts"):
+            entry[k] = os.path.abspath(os.fspath(entry[k]))
+            if not os.path.isfile(entry[k]):
+                raise FileNotFoundError(2, f"{where}: no such scene file", entry[k])
+        entry.setdefault("name", os.path.basename(entry["bodies"]))
+    else:
+        unknown = set(entry) - _SPEC_KEYS
+        if unknown or "kind" not in entry or "n" not in entry:
+            raise ValueError(f"{where}: a generated scene has 'kind' and 'n' and may have "
+                             f"{sorted(_SPEC_KEYS - {'kind', 'n'})}; got {sorted(entry)}")
+        if entry["kind"] not in ("pairs", "debris", "pile"):
+            raise ValueError(f"{where}: kind must be 'pairs', 'debris' or 'pile', got {entry['kind']!r}")
+        entry.setdefault("name", " ".join(f"{k}={entry[k]}" for k in ("kind", "n", "seed", "model", "friction",
+                                                                       "shuffle", "dtype") if k in entry))
+    if entry.get("accuracy", "fast") not in ("fast", "accurate"):
+        raise ValueError(f"{where}: accuracy must be 'fast' or 'accurate', got {entry['accuracy']!r}")
+    return entry
+
+
+def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", sample=10_000, threads=1, isa=None,
+                 workers=None, progress=False):
+    """Solves many scenes, one task each, and measures each against the
+    reference; returns a pandas DataFrame, one row per scene in the order
+    given, columns ``SCENE_COLUMNS``: scene (its name), model (the one that
+    ran), precision, accuracy, contacts, islands, largest_island,
+    collisions_per_second (the solve's, from its stats), max_error_eps (the
+    largest impulse error on the sample, in eps units of the impulse scale,
+    bound ``collide.error_bound_eps``), momentum_drift and
+    angular_momentum_drift (:func:`collide.conservation_drift` on the
+    sample) and error_sample (contacts in the sample).
+
+    Each entry of ``scenes`` is a scene file pair (a tuple of two paths, or a
+    dict with "bodies", "contacts" and optionally "dtype", "name",
+    "accuracy"), read by the worker, or the parameters of
+    :func:`collide.generate` as a dict ("kind", "n", and optionally "seed",
+    "model", "friction", "shuffle", "dtype", "name", "accuracy"), generated
+    on the worker, so nothing is stored. The sample is the scene's first
+    ``sample`` contacts, as ``collide report`` samples: solved alone it gives
+    the whole solve's first impulses (checked), and it is compared with
+    :func:`collide.reference_solve`. ``model``, ``accuracy``, ``threads``
+    (solver threads per task), ``isa``, ``client``, ``workers`` and
+    ``progress`` as for :func:`solve`.
+
+    An entry that is not understood raises before anything runs (naming the
+    entry); a scene file that is bad raises the reader's error (file, row,
+    column)."""
+    pandas = _need("pandas")
+    options = _options(model, accuracy, threads, isa, sample)
+    if options["sample"] < 0:
+        raise ValueError(f"sample must be >= 0, got {sample}")
+    entries = [_entry(i, item) for i, item in enumerate(scenes)]
+    with _connected(client, workers) as c:
+        key = f"collide-dask-scene-{uuid.uuid4().hex}"
+        futures = [c.submit(_tasks.scene_row, entry, options, key=f"{key}-{i}", pure=False)
+                   for i, entry in enumerate(entries)]
+        rows = _wait(futures, progress, "scenes")
+    return pandas.DataFrame(rows, columns=list(SCENE_COLUMNS))

@@ -1,0 +1,71 @@
+"""Islands grouped into partitions balanced by contact count (NumPy only).
+
+The grouping decides only which worker solves which islands: every island is
+solved whole, its contacts in input order, so the result does not depend on
+it (docs/distributed.md). It is deterministic, so that a run can be
+repeated and explained:
+
+1. Large islands (more than an eighth of the mean partition) first, largest
+   first (ties: the lower label), each onto the least loaded partition (ties:
+   the lower partition): the classic greedy for uneven sizes.
+2. The small islands, in label order (the order of their first contacts),
+   fill each partition up to the mean, partition after partition. Consecutive
+   islands stay together, so a partition's contacts are runs of the scene's
+   own order (a scene of independent pairs splits into contiguous ranges),
+   which keeps a worker's reads of a mapped file sequential.
+
+Every partition then holds at most the mean plus one small island, unless a
+single island is larger than the mean: that island is one partition's
+contacts, and nothing can split it.
+"""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+
+#: Islands above this fraction of the mean partition are placed one by one.
+LARGE_FRACTION = 1 / 8
+
+
+def partition_islands(sizes, partitions):
+    """The partition of each island: an int array the length of ``sizes``
+    (the contacts of each island, ``collide.islands(...).sizes``), values in
+    ``[0, partitions)``. At most ``partitions`` are used, and no more than
+    there are islands; some may stay empty when a few large islands hold
+    everything. Deterministic: the same sizes give the same partitions."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    if sizes.ndim != 1:
+        raise ValueError(f"partition_islands: sizes must be 1-D, got shape {sizes.shape}")
+    if int(partitions) < 1:
+        raise ValueError(f"partition_islands: partitions must be >= 1, got {partitions}")
+    count = len(sizes)
+    parts = np.zeros(count, dtype=np.int64)
+    p = max(1, min(int(partitions), count))
+    if count == 0 or p == 1:
+        return parts
+    target = sizes.sum() / p
+    large = sizes > target * LARGE_FRACTION
+    load = np.zeros(p, dtype=np.float64)
+    large_ids = np.flatnonzero(large)
+    if len(large_ids):
+        # Largest first; a stable sort keeps the lower label first among equals.
+        order = large_ids[np.argsort(-sizes[large_ids], kind="stable")]
+        heap = [(0, k) for k in range(p)]
+        for island in order:
+            contacts, k = heapq.heappop(heap)
+            parts[island] = k
+            contacts += int(sizes[island])
+            load[k] = contacts
+            heapq.heappush(heap, (contacts, k))
+    small_ids = np.flatnonzero(~large)
+    if len(small_ids):
+        # Partition k takes the small islands whose first contact, counted
+        # through the small islands in label order, falls in its share of
+        # the room left below the mean.
+        room = np.maximum(target - load, 0.0)
+        ends = np.cumsum(room)
+        starts = np.cumsum(sizes[small_ids]) - sizes[small_ids]
+        parts[small_ids] = np.minimum(np.searchsorted(ends, starts, side="right"), p - 1)
+    return parts

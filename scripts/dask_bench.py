@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""Figures of collide.dask (docs/distributed.md, "Figures").
+
+(a) One scene: N independent pairs (16M by default) written once as a binary
+    scene file pair into a temporary directory, then
+      * in-process: collide.load + collide.solve with --threads threads;
+      * distributed: collide.dask.solve of the file pair on a LocalCluster of
+        --workers single-threaded processes, everything included (the load
+        and check on the client, the islands, the partitions, the workers'
+        reads and their in-place writes of J, v and w);
+    and the outputs compared byte for byte (exit 1 if they differ).
+(b) Many scenes: collide.dask.solve_scenes over --scenes generated scenes
+    (pairs and debris of --scene-n contacts, generated on the workers) on a
+    LocalCluster of 1 worker and then of --workers workers.
+
+Prints each time and the ratios, and the rows of the figures table of
+docs/distributed.md. The clusters are started (and their workers warmed up:
+collide imported, the instruction-set choice measured) before anything is
+timed. Memory: the 16M-pair scene is about 2.8 GB on disk in float and the
+in-process solve holds it in memory, the comparison a second copy of v, w
+and J.
+
+    PYTHONPATH=build/python /usr/bin/python3 scripts/dask_bench.py              # the full run
+    PYTHONPATH=build/python /usr/bin/python3 scripts/dask_bench.py --n 100000 --scenes 10   # a smoke run
+"""
+
+import argparse
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import collide
+import collide.dask as cd
+
+
+def cluster(workers):
+    import distributed
+
+    c = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    client = distributed.Client(c)
+    # Warm-up, untimed: every worker imports collide and measures its ISA choice.
+    cd.solve_scenes([{"kind": "pairs", "n": 1000, "seed": s} for s in range(2 * workers)], client, sample=100)
+    return c, client
+
+
+def one_scene(args, tmp):
+    bp, cp = os.path.join(tmp, "bodies.npz"), os.path.join(tmp, "contacts.npz")
+    t = time.perf_counter()
+    bodies, contacts = collide.generate("pairs", args.n, seed=1, dtype=np.dtype(args.dtype))
+    collide.save(bp, cp, bodies, contacts)
+    del bodies, contacts
+    print(f"(a) {args.n:,} pairs written to {tmp} in {time.perf_counter() - t:.1f} s", flush=True)
+
+    t = time.perf_counter()
+    bodies, contacts = collide.load(bp, cp)
+    load_seconds = time.perf_counter() - t
+    t = time.perf_counter()
+    J, stats = collide.solve(bodies, contacts, threads=args.threads)
+    solve_seconds = time.perf_counter() - t
+    expected = (J.tobytes(), bodies.v.tobytes(), bodies.w.tobytes())
+    del J, bodies, contacts
+
+    c, client = cluster(args.workers)
+    try:
+        t = time.perf_counter()
+        solution = cd.solve((bp, cp), client, out_dir=os.path.join(tmp, "out"), threads=1)
+        dask_seconds = time.perf_counter() - t
+    finally:
+        client.close()
+        c.close()
+    same = all(np.ascontiguousarray(x).tobytes() == y for x, y in zip(solution[:3], expected))
+    s = solution.stats
+    print(f"    in-process collide.solve, {args.threads} threads: {solve_seconds:.3f} s "
+          f"(kernel {stats['kernel_seconds']:.3f} s; collide.load before it {load_seconds:.3f} s)")
+    print(f"    collide.dask.solve, {args.workers} workers: {dask_seconds:.3f} s (client load and check "
+          f"{s['read_seconds']:.3f} s, islands {s['islands_seconds']:.3f} s, partitions {s['partitions']}, "
+          f"kernels {s['kernel_seconds']:.3f} s summed)")
+    print(f"    dask / in-process solve: {dask_seconds / solve_seconds:.2f}; "
+          f"dask / (load + solve): {dask_seconds / (load_seconds + solve_seconds):.2f}")
+    print(f"    same bytes (J, v, w): {'yes' if same else 'NO'}", flush=True)
+    return same, {"solve": solve_seconds, "load": load_seconds, "dask": dask_seconds}
+
+
+def many_scenes(args):
+    kinds = ("pairs", "debris")
+    specs = [{"kind": kinds[i % 2], "n": args.scene_n, "seed": i + 1, "dtype": args.dtype} for i in range(args.scenes)]
+    seconds = {}
+    for workers in (1, args.workers):
+        c, client = cluster(workers)
+        try:
+            t = time.perf_counter()
+            table = cd.solve_scenes(specs, client, sample=args.sample)
+            seconds[workers] = time.perf_counter() - t
+        finally:
+            client.close()
+            c.close()
+        print(f"(b) solve_scenes, {args.scenes} scenes of {args.scene_n:,} contacts, {workers} worker(s): "
+              f"{seconds[workers]:.2f} s; max error {table['max_error_eps'].max():.2f} eps", flush=True)
+    print(f"    1 worker / {args.workers} workers: {seconds[1] / seconds[args.workers]:.2f}")
+    return seconds
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--n", type=int, default=16_000_000, help="pairs of the one-scene run (default 16M)")
+    p.add_argument("--scenes", type=int, default=200, help="scenes of the many-scene run (default 200)")
+    p.add_argument("--scene-n", type=int, default=100_000, help="contacts per scene (default 100k)")
+    p.add_argument("--sample", type=int, default=10_000, help="contacts per scene compared with the reference")
+    p.add_argument("--workers", type=int, default=2, help="Dask worker processes, one thread each (default 2)")
+    p.add_argument("--threads", type=int, default=2, help="threads of the in-process solve (default 2)")
+    p.add_argument("--dtype", default="float32", choices=("float32", "float64"))
+    p.add_argument("--tmp", default=None, help="directory for the scene files (default: a new one in $TMPDIR)")
+    args = p.parse_args()
+    tmp = tempfile.mkdtemp(prefix="collide-dask-bench-", dir=args.tmp)
+    try:
+        same, a = one_scene(args, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    b = many_scenes(args)
+    print(f"\nFigures rows ({platform.processor() or platform.machine()}, {os.cpu_count()} hardware threads, "
+          f"{args.dtype}):\n")
+    print("| run | reference | collide.dask | ratio |")
+    print("| --- | ---: | ---: | ---: |")
+    print(f"| one scene, {args.n:,} pairs from a binary file | {a['solve']:.3f} s (solve, {args.threads} threads; "
+          f"+{a['load']:.3f} s load) | {a['dask']:.3f} s ({args.workers} workers, all included) | "
+          f"{a['dask'] / a['solve']:.2f} (dask / in-process) |")
+    print(f"| {args.scenes} scenes of {args.scene_n:,} contacts | {b[1]:.2f} s (1 worker) | {b[args.workers]:.2f} s "
+          f"({args.workers} workers) | {b[1] / b[args.workers]:.2f} (1 worker / {args.workers}) |")
+    return 0 if same else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

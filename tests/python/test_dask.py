@@ -1,0 +1,401 @@
+"""collide.dask on a real LocalCluster (2 worker processes of one thread):
+the same bytes as collide.solve, scenes given as arrays or as binary scene
+files, the partitions, the giant-island warning, solve_scenes' table, the
+command, bad input, a worker killed mid-run, and `import collide` without
+Dask.
+
+The cluster is started once for the module. Dask, distributed and pandas are
+required (scripts/install-deps.sh installs them): without them the fixture
+fails, it does not skip.
+"""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import warnings
+
+import numpy as np
+import pytest
+
+import distributed
+
+import collide
+import collide.dask as cd
+
+FIELDS = ("inv_mass", "inv_inertia", "q", "p", "v", "w")
+
+
+@pytest.fixture(scope="module")
+def client():
+    import cloudpickle
+
+    # The worker plugin below is defined here: the workers get it by value.
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+        yield c
+
+
+def copy_scene(bodies, contacts):
+    """An exact copy over new arrays (a scene to solve twice)."""
+    b = collide.Bodies(*(np.array(getattr(bodies, f), copy=True, order="C") for f in FIELDS))
+    opt = {k: None if getattr(contacts, k) is None else np.array(getattr(contacts, k), copy=True) for k in ("e", "mu")}
+    c = collide.Contacts(np.array(contacts.a), np.array(contacts.b), np.array(contacts.c, order="C"),
+                         np.array(contacts.n, order="C"), opt["e"], contacts.uniform_e, opt["mu"])
+    return b, c
+
+
+def island_scene(model="rigid", dtype=np.float64, seed=1, friction=True, piles=6):
+    """Many islands over one shared ground: small piles, debris clusters and
+    free pairs generated for `model`, every immovable body replaced by the
+    first one in the contacts (so the piles stand on one ground), contacts of
+    all the parts interleaved by a seeded shuffle."""
+    parts = []
+    for k in range(piles):
+        parts.append(collide.generate("pile", 2 + k % 2, model=model, friction=friction, seed=seed + k, dtype=dtype))
+        parts.append(collide.generate("debris", 30, model=model, friction=friction, seed=seed + 50 + k, dtype=dtype))
+    parts.append(collide.generate("pairs", 60, model=model, friction=friction, seed=seed + 99, dtype=dtype))
+    offsets = np.cumsum([0] + [len(b) for b, _ in parts])
+    fields = {f: np.concatenate([getattr(b, f) for b, _ in parts], axis=-1) for f in FIELDS}
+    a = np.concatenate([c.a + o for (_, c), o in zip(parts, offsets)]).astype(np.uint32)
+    b = np.concatenate([c.b + o for (_, c), o in zip(parts, offsets)]).astype(np.uint32)
+    ground = np.flatnonzero(fields["inv_mass"] == 0)[0]
+    for x in (a, b):
+        x[fields["inv_mass"][x] == 0] = ground
+    order = np.random.default_rng(seed).permutation(len(a))
+    cat = lambda name: np.concatenate([getattr(c, name) for _, c in parts], axis=-1)  # noqa: E731
+    mu = cat("mu")[order] if friction else None
+    bodies = collide.Bodies(*(np.ascontiguousarray(fields[f]) for f in FIELDS))
+    contacts = collide.Contacts(a[order], b[order], np.ascontiguousarray(cat("c")[:, order]),
+                                np.ascontiguousarray(cat("n")[:, order]), cat("e")[order], mu=mu)
+    return bodies, contacts
+
+
+def reference_bytes(bodies, contacts, **kwargs):
+    """collide.solve on a copy: the bytes a distributed solve must give."""
+    b, c = copy_scene(bodies, contacts)
+    J, stats = collide.solve(b, c, **kwargs)
+    return J.tobytes(), b.v.tobytes(), b.w.tobytes(), stats
+
+
+def same_bytes(solution, expected):
+    J, v, w, _ = expected
+    assert np.ascontiguousarray(solution.J).tobytes() == J
+    assert np.ascontiguousarray(solution.v).tobytes() == v
+    assert np.ascontiguousarray(solution.w).tobytes() == w
+
+
+def test_the_scene_has_many_islands_and_a_ground():
+    bodies, contacts = island_scene()
+    isl = collide.islands(bodies, contacts)
+    ground = np.flatnonzero(bodies.inv_mass == 0)[0]
+    assert isl.count > 60 and isl.largest < len(contacts) / 4
+    assert np.count_nonzero((contacts.a == ground) | (contacts.b == ground)) > 10
+    assert isl.body_labels[ground] == collide.Islands.NONE
+
+
+@pytest.mark.parametrize("model", ["particle", "sphere", "rigid"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("accuracy", ["fast", "accurate"])
+def test_arrays_same_bytes_as_collide_solve(client, model, dtype, accuracy):
+    bodies, contacts = island_scene(model, dtype, seed=3)
+    expected = reference_bytes(bodies, contacts, accuracy=accuracy)
+    assert expected[3]["model"] == model
+    solution = cd.solve((bodies, contacts), client, accuracy=accuracy)
+    same_bytes(solution, expected)
+    assert solution.v is bodies.v and solution.w is bodies.w, "the caller's arrays, updated in place"
+    assert solution.stats["model"] == model and solution.stats["accuracy"] == accuracy
+    assert len(solution.stats["partitions"]) == 2 and sum(solution.stats["partitions"]) == len(contacts)
+
+
+def test_grouping_and_forced_model_do_not_change_the_bytes(client):
+    bodies, contacts = island_scene("sphere", np.float32, seed=5, friction=False)
+    expected = reference_bytes(bodies, contacts, model="rigid")
+    for partitions in (1, 3, 7, 1000):
+        b, c = copy_scene(bodies, contacts)
+        solution = cd.solve((b, c), client, partitions=partitions, model="rigid")
+        same_bytes(solution, expected)
+        assert len(solution.stats["partitions"]) == min(partitions, collide.islands(b, c).count)
+
+
+@pytest.mark.parametrize("model,dtype,accuracy,shuffled", [
+    ("rigid", np.float32, "fast", True),
+    ("sphere", np.float64, "accurate", True),
+    ("particle", np.float64, "fast", False),
+    ("rigid", np.float64, "accurate", False),
+])
+def test_scene_files_same_bytes_written_in_place(client, tmp_path, model, dtype, accuracy, shuffled):
+    if shuffled:
+        bodies, contacts = island_scene(model, dtype, seed=7)
+    else:  # independent pairs: every partition a range of contacts
+        bodies, contacts = collide.generate("pairs", 5000, model=model, friction=True, seed=7, dtype=dtype)
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    expected = reference_bytes(*collide.load(bp, cp), accuracy=accuracy)
+    out = tmp_path / "out"
+    solution = cd.solve((bp, cp), client, out_dir=out, accuracy=accuracy, partitions=3)
+    same_bytes(solution, expected)
+    assert sorted(os.listdir(out)) == ["J.npy", "v.npy", "w.npy"], "nothing else left behind"
+    for name, array in zip("Jvw", solution[:3]):
+        assert isinstance(array, np.memmap) and os.path.samefile(array.filename, out / f"{name}.npy")
+        assert array.dtype == dtype
+    assert solution.stats["outputs"]["J"] == str(out / "J.npy")
+    # The file converted on load, as collide.load(dtype=) converts it.
+    if dtype == np.float64:
+        expected32 = reference_bytes(*collide.load(bp, cp, dtype=np.float32), accuracy=accuracy)
+        same_bytes(cd.solve((bp, cp), client, out_dir=tmp_path / "out32", dtype=np.float32, accuracy=accuracy),
+                   expected32)
+
+
+def test_workers_map_the_members_of_scene_files(tmp_path):
+    from collide.dask._files import npz_columns
+
+    bodies, contacts = collide.generate("debris", 500, friction=True, dtype=np.float32)
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, bodies, contacts)
+    np.savez(tmp_path / "numpy.npz", x=np.arange(7, dtype=np.int64), empty=np.zeros(0))
+    for path in (bp, cp, tmp_path / "numpy.npz"):
+        columns = npz_columns(path)
+        with np.load(path) as z:
+            assert sorted(columns) == sorted(z.files)
+            for name in z.files:
+                assert columns[name].dtype == z[name].dtype and columns[name].tobytes() == z[name].tobytes(), name
+                assert isinstance(columns[name], np.memmap) or columns[name].size == 0
+                assert not columns[name].flags.writeable or columns[name].size == 0
+    np.savez_compressed(tmp_path / "z.npz", x=np.arange(7))
+    with pytest.raises(ValueError, match=r"z\.npz: member 'x\.npy' is compressed"):
+        npz_columns(tmp_path / "z.npz")
+
+
+def test_partition_islands_is_a_balanced_deterministic_greedy():
+    # Equal islands: consecutive runs of equal size.
+    parts = cd.partition_islands(np.full(100, 5), 4)
+    np.testing.assert_array_equal(parts, np.repeat(np.arange(4), 25))
+    # Large islands first onto the least loaded partition, then the small ones fill up to the mean.
+    sizes = np.array([40, 100, 50, 60] + [1] * 50)
+    parts = cd.partition_islands(sizes, 3)
+    np.testing.assert_array_equal(parts[:4], [2, 0, 2, 1])
+    np.testing.assert_array_equal(np.bincount(parts, weights=sizes), [100, 100, 100])
+    # One giant island is one partition; the rest go to the others.
+    parts = cd.partition_islands([1000, 1, 1, 1], 2)
+    np.testing.assert_array_equal(parts, [0, 1, 1, 1])
+    # Random sizes: every partition within one small island of the mean, the same answer every time.
+    rng = np.random.default_rng(2)
+    for p in (2, 3, 8, 13):
+        sizes = np.concatenate([rng.integers(1, 20, 3000), rng.integers(200, 2000, 5)])
+        parts = cd.partition_islands(sizes, p)
+        np.testing.assert_array_equal(parts, cd.partition_islands(sizes, p))
+        loads = np.bincount(parts, weights=sizes, minlength=p)
+        assert len(loads) == p and loads.sum() == sizes.sum()
+        mean = sizes.sum() / p
+        assert loads.max() <= max(mean + 20, sizes.max()), (p, loads, mean)
+    # More partitions than islands: one island each.
+    np.testing.assert_array_equal(cd.partition_islands([3, 2], 5), [0, 1])
+    assert len(cd.partition_islands([], 3)) == 0
+    with pytest.raises(ValueError, match="partitions must be >= 1"):
+        cd.partition_islands([1, 2], 0)
+
+
+def test_stats_partitions_are_balanced(client):
+    bodies, contacts = collide.generate("pairs", 10_000, dtype=np.float32)
+    solution = cd.solve((bodies, contacts), client, partitions=4)
+    assert solution.stats["partitions"] == [2500] * 4
+    assert solution.stats["islands"] == 10_000 and solution.stats["largest_island"] == 1
+
+
+def test_a_giant_island_warns_and_is_solved_whole(client):
+    bodies, contacts = collide.generate("pile", 7, friction=True, dtype=np.float32)
+    expected = reference_bytes(bodies, contacts)
+    figures = rf"largest island holds {len(contacts):,} of {len(contacts):,} contacts \(100%; 1 islands\)"
+    with pytest.warns(cd.IslandWarning, match=figures):
+        solution = cd.solve((bodies, contacts), client, partitions=4)
+    same_bytes(solution, expected)
+    assert solution.stats["partitions"] == [len(contacts)]
+    # A scene of many islands does not warn.
+    bodies, contacts = island_scene()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cd.IslandWarning)
+        cd.solve((bodies, contacts), client)
+
+
+def test_solve_scenes_table(client, tmp_path):
+    bodies, contacts = island_scene("rigid", np.float64, seed=9)
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, bodies, contacts)
+    scenes = [{"kind": "pairs", "n": 20_000, "seed": 3, "model": "particle", "dtype": "float32"},
+              {"kind": "debris", "n": 3000, "seed": 4, "friction": True, "dtype": np.float64, "name": "my debris"},
+              (bp, cp),
+              {"kind": "pile", "n": 5, "accuracy": "accurate"}]
+    table = cd.solve_scenes(scenes, client, sample=2000)
+    assert list(table.columns) == list(cd.SCENE_COLUMNS)
+    assert list(table["scene"]) == ["kind=pairs n=20000 seed=3 model=particle dtype=float32", "my debris", "b.npz",
+                                    "kind=pile n=5"]
+    assert list(table["model"]) == ["particle", "rigid", "rigid", "rigid"]
+    assert list(table["precision"]) == ["float", "double", "double", "float"]
+    assert list(table["accuracy"]) == ["fast", "fast", "fast", "accurate"]
+    pile_contacts = len(collide.generate("pile", 5)[1])
+    assert list(table["contacts"]) == [20_000, 3000, len(contacts), pile_contacts]
+    assert table["islands"][0] == 20_000 and table["largest_island"][0] == 1
+    assert table["islands"][2] == collide.islands(bodies, contacts).count
+    assert list(table["error_sample"]) == [2000, 2000, min(2000, len(contacts)), min(2000, pile_contacts)]
+    assert (table["collisions_per_second"] > 0).all()
+    assert (table["max_error_eps"] <= collide.error_target_eps).all(), table["max_error_eps"]
+    assert (table["max_error_eps"] > 0).any()
+    assert (table["momentum_drift"].abs() < 1e-5).all() and (table["angular_momentum_drift"].abs() < 1e-5).all()
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "collide.dask", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_the_command(client, tmp_path):
+    bodies, contacts = island_scene("sphere", np.float32, seed=11)
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, bodies, contacts)
+    expected = reference_bytes(*collide.load(bp, cp))
+    address = client.scheduler.address
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "out"), "--scheduler", address)
+    assert r.returncode == 0, r.stderr
+    stats = json.loads(r.stdout)
+    assert stats["collisions"] == len(contacts) and stats["model"] == "sphere"
+    assert "partitions done" in r.stderr, "a line per task when stderr is not a terminal"
+    same_bytes(cd.Solution(*(np.load(tmp_path / "out" / f"{k}.npy") for k in "Jvw"), {}), expected)
+
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps([{"kind": "pairs", "n": 3000, "seed": 2}, {"bodies": "b.npz", "contacts": "c.npz"}]))
+    # Its own LocalCluster of one worker this time.
+    r = run_cli("scenes", str(spec), "--out", str(tmp_path / "t.csv"), "--workers", "1", "--sample", "500",
+                "--no-progress")
+    assert r.returncode == 0, r.stderr
+    lines = (tmp_path / "t.csv").read_text().splitlines()
+    assert lines[0] == ",".join(cd.SCENE_COLUMNS) and len(lines) == 3
+    assert lines[1].startswith("kind=pairs n=3000 seed=2,rigid,float,fast,3000,3000,1,")
+    assert lines[2].startswith(f"b.npz,sphere,float,fast,{len(contacts)},")
+
+
+def test_bad_input(client, tmp_path):
+    # Arrays: the library's message, nothing written.
+    bodies, contacts = island_scene(seed=13)
+    contacts.b[3] = len(bodies)
+    v0 = bodies.v.copy()
+    with pytest.raises(ValueError, match=rf"contacts\.b\[3\] = {len(bodies)}: out of range"):
+        cd.solve((bodies, contacts), client)
+    assert bodies.v.tobytes() == v0.tobytes()
+    with pytest.raises(TypeError, match="collide.Bodies"):
+        cd.solve((contacts, bodies), client)
+    with pytest.raises(ValueError, match="model 'particle' does not fit"):
+        cd.solve(collide.generate("pairs", 10), client, model="particle")
+    with pytest.raises(ValueError, match="accuracy must be"):
+        cd.solve(collide.generate("pairs", 10), client, accuracy="exact")
+
+    # Files: the reader's message (file, row, column), no output.
+    bodies, contacts = collide.generate("pairs", 100, dtype=np.float64)
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, bodies, contacts)
+    with np.load(bp) as z:
+        cols = {k: z[k].copy() for k in z.files}
+    cols["m"][4] = -1
+    np.savez(bp, **cols)
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match=r"b\.npz: row 4, column 'm': mass must be > 0, got -1"):
+        cd.solve((bp, cp), client, out_dir=out)
+    assert not out.exists() or os.listdir(out) == []
+    with pytest.raises(ValueError, match="out_dir"):
+        cd.solve((bp, cp), client)
+    csv_b, csv_c = str(tmp_path / "b.csv"), str(tmp_path / "c.csv")
+    collide.save(csv_b, csv_c, *collide.generate("pairs", 10))
+    with pytest.raises(ValueError, match=r"b\.csv: workers map their rows of a binary scene file"):
+        cd.solve((csv_b, csv_c), client, out_dir=out)
+    with pytest.raises(ValueError, match="scene 1: a generated scene has 'kind' and 'n'"):
+        cd.solve_scenes([{"kind": "pairs", "n": 10}, {"kind": "pairs", "size": 10}], client)
+    with pytest.raises(FileNotFoundError, match="scene 0: no such scene file"):
+        cd.solve_scenes([(str(tmp_path / "missing.npz"), cp)], client)
+    with pytest.raises(ValueError, match=r"b\.npz: row 4, column 'm'"):
+        cd.solve_scenes([(bp, cp)], client)
+
+    # The command: exit 1, the file named.
+    address = client.scheduler.address
+    r = run_cli("solve", bp, cp, "--out-dir", str(out), "--scheduler", address)
+    assert r.returncode == 1 and "collide-dask: error:" in r.stderr and "b.npz: row 4, column 'm'" in r.stderr
+    r = run_cli("solve", str(tmp_path / "nope.npz"), cp, "--out-dir", str(out), "--scheduler", address)
+    assert r.returncode == 1 and "nope.npz" in r.stderr, r.stderr
+    bad_spec = tmp_path / "bad.json"
+    bad_spec.write_text("[{\"kind\": \"pairs\"")
+    r = run_cli("scenes", str(bad_spec), "--scheduler", address)
+    assert r.returncode == 1 and "bad.json: not valid JSON" in r.stderr, r.stderr
+    r = run_cli("scenes", bp, "--scheduler", address)
+    assert r.returncode == 1 and "pairs of binary scene files" in r.stderr, r.stderr
+    r = run_cli("solve", bp, cp)
+    assert r.returncode == 2 and "--out-dir" in r.stderr
+
+
+class KillOnce(distributed.WorkerPlugin):
+    """A worker plugin that kills its worker process (os._exit) when a
+    partition task starts there, the first time only: the marker file says
+    it happened, for every worker and for the restarted one."""
+
+    name = "collide-test-kill-once"
+
+    def __init__(self, marker):
+        self.marker = marker
+
+    def transition(self, key, start, finish, **kwargs):
+        if finish == "executing" and "collide-dask-part-" in str(key):
+            try:
+                fd = os.open(self.marker, os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                return
+            os.close(fd)
+            os._exit(1)
+
+
+@pytest.mark.parametrize("files", [True, False])
+def test_a_worker_killed_mid_run_gives_the_same_bytes(client, tmp_path, files):
+    bodies, contacts = island_scene("rigid", np.float32, seed=17)
+    marker = str(tmp_path / "killed")
+    client.register_worker_plugin(KillOnce(marker))
+    try:
+        if files:
+            bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+            collide.save(bp, cp, bodies, contacts)
+            expected = reference_bytes(*collide.load(bp, cp))
+            solution = cd.solve((bp, cp), client, out_dir=tmp_path / "out", partitions=4)
+        else:
+            expected = reference_bytes(bodies, contacts)
+            solution = cd.solve((bodies, contacts), client, partitions=4)
+    finally:
+        client.unregister_worker_plugin(KillOnce.name)
+    assert os.path.exists(marker), "a worker was killed during the run"
+    same_bytes(solution, expected)
+    client.wait_for_workers(2, timeout=60)
+
+
+def test_import_collide_without_dask():
+    code = textwrap.dedent("""
+        import importlib.abc, sys
+
+        class Blocked(importlib.abc.MetaPathFinder):
+            def find_spec(self, name, path, target=None):
+                if name.split(".")[0] in ("dask", "distributed", "pandas"):
+                    raise ImportError(f"No module named '{name}' (blocked)")
+                return None
+
+        sys.meta_path.insert(0, Blocked())
+        import numpy as np
+        import collide, collide.dask
+        assert not [m for m in sys.modules if m.split(".")[0] in ("dask", "distributed", "pandas")]
+        bodies, contacts = collide.generate("pairs", 100)
+        J, stats = collide.solve(bodies, contacts)
+        print(collide.islands(bodies, contacts).count, collide.dask.partition_islands([3, 1, 2], 2).tolist())
+        try:
+            collide.dask.solve((bodies, contacts))
+        except ImportError as e:
+            print("ImportError:", e)
+    """)
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0] == "100 [0, 1, 1]"
+    assert lines[1].startswith("ImportError: collide.dask needs distributed (Debian: python3-dask python3-distributed")
