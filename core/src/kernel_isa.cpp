@@ -118,6 +118,22 @@ inline constexpr bool kSoaLayout = true;
 template <class Record>
 inline constexpr bool kSoaLayout<PackedView<Record>> = false;
 
+/// The bodies ia[0..W) and ib[0..W) into lanes by index: gathers from the
+/// SoA arrays, or row loads and transposes from packed records.
+template <class M, class V, class T, class View>
+COLLIDE_LANE_INLINE void gather_bodies(const View& bodies, const BodyIndex* ia, const BodyIndex* ib, BodyLanes<M, V>& a,
+                                       BodyLanes<M, V>& b) {
+  if constexpr (kSoaLayout<View>) {
+    read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      la = gather<V>(field, ia);
+      lb = gather<V>(field, ib);
+    });
+  } else {
+    read_records<M, V>(bodies, ia, a);
+    read_records<M, V>(bodies, ib, b);
+  }
+}
+
 /// Resolves one group of V::size() contacts.
 template <class M, class V, bool kFriction, class Mode, class T, class View>
 COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
@@ -146,17 +162,7 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
       });
     }
   }
-  if constexpr (kSoaLayout<View>) {
-    if (!paired) {
-      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-        la = gather<V>(field, ia);
-        lb = gather<V>(field, ib);
-      });
-    }
-  } else {
-    read_records<M, V>(bodies, ia, a);
-    read_records<M, V>(bodies, ib, b);
-  }
+  if (!paired) gather_bodies<M, V, T>(bodies, ia, ib, a, b);
 
   ContactLanes<V> c;
   if constexpr (kRotates<M>) {
@@ -370,15 +376,7 @@ COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& 
   }
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
-  if constexpr (kSoaLayout<View>) {
-    read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-      la = gather<V>(field, ia);
-      lb = gather<V>(field, ib);
-    });
-  } else {
-    read_records<M, V>(bodies, ia, a);
-    read_records<M, V>(bodies, ib, b);
-  }
+  gather_bodies<M, V, T>(bodies, ia, ib, a, b);
   ContactLanes<V> c;
   if constexpr (kRotates<M>)
     c.c = {gather<V>(contacts.c.x, index), gather<V>(contacts.c.y, index), gather<V>(contacts.c.z, index)};
