@@ -352,6 +352,23 @@ TEST(PileScene, NeedsTheRigidModel) {
   }
 }
 
+/// `first`, drawn with seed 21 and friction: seed 22 draws another scene, and
+/// without friction the first 100 contacts keep their e and bodies their
+/// velocities, with mu = 0. `draw(options)` draws the same kind and size.
+template <class Draw>
+void expect_seed_and_friction_effects(const collide::Scene<double>& first, const Draw& draw) {
+  const auto other = draw({22, true});
+  EXPECT_NE(other.contacts.record(0).c[1], first.contacts.record(0).c[1]);
+  EXPECT_NE(other.bodies.record(0).m, first.bodies.record(0).m);
+  const auto frictionless = draw({21, false});
+  for (std::size_t k = 0; k < 100; ++k) {
+    EXPECT_EQ(frictionless.contacts.record(k).mu, 0.0);
+    EXPECT_GT(first.contacts.record(k).mu, 0.0);
+    EXPECT_EQ(frictionless.contacts.record(k).e, first.contacts.record(k).e);
+    EXPECT_EQ(frictionless.bodies.record(k).v[0], first.bodies.record(k).v[0]);
+  }
+}
+
 TEST(PileScene, PureFunctionOfSideOptionsAndSeed) {
   const collide::GenerateOptions o{21, true};
   const std::size_t side = 24;  // 13825 bodies, 40320 contacts: several blocks of work
@@ -382,16 +399,8 @@ TEST(PileScene, PureFunctionOfSideOptionsAndSeed) {
     EXPECT_EQ(got.e, contact.e);
     EXPECT_EQ(got.mu, contact.mu);
   }
-  // Other seeds, other piles; friction changes mu only.
-  const auto other = collide::generate_pile<double>(side, {22, true});
-  EXPECT_NE(other.contacts.record(0).c[1], first.contacts.record(0).c[1]);
-  EXPECT_NE(other.bodies.record(0).m, first.bodies.record(0).m);
-  const auto frictionless = collide::generate_pile<double>(side, {21, false});
-  for (std::size_t k = 0; k < 100; ++k) {
-    EXPECT_EQ(frictionless.contacts.record(k).mu, 0.0);
-    EXPECT_GT(first.contacts.record(k).mu, 0.0);
-    EXPECT_EQ(frictionless.contacts.record(k).e, first.contacts.record(k).e);
-  }
+  expect_seed_and_friction_effects(
+      first, [&](const collide::GenerateOptions& g) { return collide::generate_pile<double>(side, g); });
 }
 
 TEST(PileScene, FloatIsTheDoubleDrawRoundedOnce) {
@@ -729,17 +738,8 @@ TEST(ChainScene, PureFunctionOfSeedAndK) {
   EXPECT_EQ(shorter.contacts.record(77).e, first.contacts.record(77).e);
   EXPECT_EQ(shorter.bodies.record(77).v[0], first.bodies.record(77).v[0]);
   EXPECT_EQ(shorter.bodies.record(78).p[1], first.bodies.record(78).p[1]);
-  // Another seed, another chain; friction changes mu only.
-  const auto other = collide::generate_chain<double>(n, {22, true});
-  EXPECT_NE(other.contacts.record(0).c[1], first.contacts.record(0).c[1]);
-  EXPECT_NE(other.bodies.record(0).m, first.bodies.record(0).m);
-  const auto frictionless = collide::generate_chain<double>(n, {21, false});
-  for (std::size_t k = 0; k < 100; ++k) {
-    EXPECT_EQ(frictionless.contacts.record(k).mu, 0.0);
-    EXPECT_GT(first.contacts.record(k).mu, 0.0);
-    EXPECT_EQ(frictionless.contacts.record(k).e, first.contacts.record(k).e);
-    EXPECT_EQ(frictionless.bodies.record(k).v[0], first.bodies.record(k).v[0]);
-  }
+  expect_seed_and_friction_effects(
+      first, [&](const collide::GenerateOptions& g) { return collide::generate_chain<double>(n, g); });
   // Not the pile's values: the chain draws from streams of its own.
   const auto pile = collide::generate_pile<double>(2, o);
   EXPECT_NE(pile.bodies.record(0).m, first.bodies.record(0).m);
