@@ -138,8 +138,7 @@ struct PySolver {
                     const py::object& out, bool check, bool impacts) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
-    T* jp = data<T>(j);
-    const ImpulseView<T> jv{contacts.count, {jp, jp + contacts.count, jp + 2 * contacts.count}};
+    const ImpulseView<T> jv{contacts.count, vec3<T>(j)};  // rows one stride apart, as checked_array allows
     const ContactView<T> cv = contacts.view<T>();
     // Unchecked values are the caller's word; indices never are (memory
     // safety). A schedule built here checks every index in its own pass
@@ -261,8 +260,8 @@ py::array impulse_error_py(const py::object& j_in, const Reference& ref) {
   return with_dtype(dtype, [&](auto tag) {
     using T = decltype(tag);
     const std::size_t m = length(j);
-    const T* p = data<T>(j);
-    const ImpulseView<const T> jv{m, {p, p + m, p + 2 * m}};
+    const Vec3Array<T> rows = vec3<T>(j);
+    const ImpulseView<const T> jv{m, {rows.x, rows.y, rows.z}};
     const std::vector<double> errors = impulse_errors_eps<T>(jv, ref.impulses.view(), ref.diagnostics);
     py::array_t<double> out(static_cast<py::ssize_t>(m));
     std::copy(errors.begin(), errors.end(), out.mutable_data());

@@ -68,6 +68,23 @@ def test_zero_copy_and_in_place():
     J2, _ = collide.solve(collide.Bodies(*arrays2), contacts, out=out)
     assert J2.ctypes.data == out.ctypes.data and np.array_equal(out, J)
 
+    # out= and v, w as columns of wider arrays (rows one stride apart, as a
+    # mapped file gives them): each row written where it lies, nothing
+    # around it touched; J's error read from the same rows.
+    m, n = len(contacts), len(bodies)
+    wide_j = np.full((3, m + 7), -1.0)
+    wide_v, wide_w = np.full((3, n + 5), -2.0), np.full((3, n + 5), -3.0)
+    wide_v[:, 2:n + 2], wide_w[:, 2:n + 2] = v0, w0
+    arrays3 = [np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q, bodies.p)]
+    J3, _ = collide.solve(collide.Bodies(*arrays3, wide_v[:, 2:n + 2], wide_w[:, 2:n + 2]), contacts,
+                          out=wide_j[:, 3:m + 3])
+    assert J3.tobytes() == J.tobytes() and wide_j[:, 3:m + 3].tobytes() == J.tobytes()
+    assert (wide_j[:, :3] == -1).all() and (wide_j[:, m + 3:] == -1).all()
+    assert wide_v[:, 2:n + 2].tobytes() == bodies.v.tobytes() and wide_w[:, 2:n + 2].tobytes() == bodies.w.tobytes()
+    assert (wide_v[:, :2] == -2).all() and (wide_v[:, n + 2:] == -2).all() and (wide_w[:, n + 2:] == -3).all()
+    ref = collide.reference_solve(collide.Bodies(*arrays3, v0.copy(), w0.copy()), contacts)
+    assert collide.impulse_error(wide_j[:, 3:m + 3], ref).tobytes() == collide.impulse_error(J, ref).tobytes()
+
 
 def test_paths_models_threads_and_isas_agree():
     bodies, contacts = collide.generate("debris", 5000, friction=True, dtype=np.float32)
