@@ -3,7 +3,8 @@
 
 (a) One scene: N independent pairs (16M by default) written once as a binary
     scene file pair into a temporary directory, then
-      * in-process: collide.load + collide.solve with --threads threads;
+      * in-process: collide.load + collide.solve with --threads threads +
+        np.save of J, v and w (file to file, as the distributed run);
       * distributed: collide.dask.solve of the file pair on a LocalCluster of
         --workers single-threaded processes, everything included (the load
         and check on the client, the islands, the partitions, the workers'
@@ -56,34 +57,60 @@ def one_scene(args, tmp):
     del bodies, contacts
     print(f"(a) {args.n:,} pairs written to {tmp} in {time.perf_counter() - t:.1f} s", flush=True)
 
-    t = time.perf_counter()
-    bodies, contacts = collide.load(bp, cp)
-    load_seconds = time.perf_counter() - t
-    t = time.perf_counter()
-    J, stats = collide.solve(bodies, contacts, threads=args.threads)
-    solve_seconds = time.perf_counter() - t
-    expected = (J.tobytes(), bodies.v.tobytes(), bodies.w.tobytes())
-    del J, bodies, contacts
-
-    c, client = cluster(args.workers)
-    try:
+    def in_process():
         t = time.perf_counter()
-        solution = cd.solve((bp, cp), client, out_dir=os.path.join(tmp, "out"), threads=1)
-        dask_seconds = time.perf_counter() - t
+        bodies, contacts = collide.load(bp, cp)
+        load = time.perf_counter() - t
+        t = time.perf_counter()
+        J, stats = collide.solve(bodies, contacts, threads=args.threads)
+        solve = time.perf_counter() - t
+        # The same job as the distributed one, file to file: J, v and w
+        # saved as .npy files (what collide.dask.solve writes).
+        t = time.perf_counter()
+        os.makedirs(os.path.join(tmp, "in-process"), exist_ok=True)
+        for name, array in (("J", J), ("v", bodies.v), ("w", bodies.w)):
+            np.save(os.path.join(tmp, "in-process", f"{name}.npy"), array)
+        save = time.perf_counter() - t
+        return {"load": load, "solve": solve, "save": save, "file_to_file": load + solve + save,
+                "kernel": stats["kernel_seconds"]}, (J.tobytes(), bodies.v.tobytes(), bodies.w.tobytes())
+
+    # Both sides alternated, each side's best run kept: a VM hands back
+    # memory its guest has not touched for a while, and whichever run first
+    # touches it pays for that, not for its own work.
+    c, client = cluster(args.workers)
+    runs, dask_runs = [], []
+    try:
+        for _ in range(args.runs):
+            figures, expected = in_process()
+            runs.append(figures)
+            t = time.perf_counter()
+            solution = cd.solve((bp, cp), client, out_dir=os.path.join(tmp, "out"), threads=1)
+            dask_runs.append((time.perf_counter() - t, solution))
+            del solution
     finally:
         client.close()
         c.close()
+    a = min(runs, key=lambda r: r["file_to_file"])
+    dask_seconds, solution = min(dask_runs, key=lambda r: r[0])
+    load_seconds, solve_seconds, save_seconds, file_to_file = a["load"], a["solve"], a["save"], a["file_to_file"]
+    stats = {"kernel_seconds": a["kernel"]}
     same = all(np.ascontiguousarray(x).tobytes() == y for x, y in zip(solution[:3], expected))
     s = solution.stats
     print(f"    in-process collide.solve, {args.threads} threads: {solve_seconds:.3f} s "
           f"(kernel {stats['kernel_seconds']:.3f} s; collide.load before it {load_seconds:.3f} s)")
     print(f"    collide.dask.solve, {args.workers} workers: {dask_seconds:.3f} s (client load and check "
           f"{s['read_seconds']:.3f} s, islands {s['islands_seconds']:.3f} s, partitions {s['partitions']}, "
-          f"kernels {s['kernel_seconds']:.3f} s summed)")
-    print(f"    dask / in-process solve: {dask_seconds / solve_seconds:.2f}; "
-          f"dask / (load + solve): {dask_seconds / (load_seconds + solve_seconds):.2f}")
+          f"kernels {s['kernel_seconds']:.3f} s summed, partition tasks "
+          f"{', '.join(f'{x:.3f}' for x in s['partition_seconds'])} s)")
+    print(f"    in-process file to file (load + solve + np.save of J, v, w): {file_to_file:.3f} s "
+          f"(save {save_seconds:.3f} s)")
+    print(f"    throughput, dask / in-process: {solve_seconds / dask_seconds:.3f} of the solve alone, "
+          f"{file_to_file / dask_seconds:.2f} of file to file")
     print(f"    same bytes (J, v, w): {'yes' if same else 'NO'}", flush=True)
-    return same, {"solve": solve_seconds, "load": load_seconds, "dask": dask_seconds}
+    print("    every run (in-process file to file / dask): " +
+          ", ".join(f"{r['file_to_file']:.3f} / {d[0]:.3f} s" for r, d in zip(runs, dask_runs)))
+    return same, {"solve": solve_seconds, "load": load_seconds, "save": save_seconds, "file_to_file": file_to_file,
+                  "dask": dask_seconds}
 
 
 def many_scenes(args):
@@ -114,6 +141,7 @@ def main():
     p.add_argument("--workers", type=int, default=2, help="Dask worker processes, one thread each (default 2)")
     p.add_argument("--threads", type=int, default=2, help="threads of the in-process solve (default 2)")
     p.add_argument("--dtype", default="float32", choices=("float32", "float64"))
+    p.add_argument("--runs", type=int, default=2, help="runs of each side of (a), alternated; the best is kept")
     p.add_argument("--tmp", default=None, help="directory for the scene files (default: a new one in $TMPDIR)")
     args = p.parse_args()
     tmp = tempfile.mkdtemp(prefix="collide-dask-bench-", dir=args.tmp)
@@ -126,9 +154,10 @@ def main():
           f"{args.dtype}):\n")
     print("| run | reference | collide.dask | ratio |")
     print("| --- | ---: | ---: | ---: |")
-    print(f"| one scene, {args.n:,} pairs from a binary file | {a['solve']:.3f} s (solve, {args.threads} threads; "
-          f"+{a['load']:.3f} s load) | {a['dask']:.3f} s ({args.workers} workers, all included) | "
-          f"{a['dask'] / a['solve']:.2f} (dask / in-process) |")
+    print(f"| one scene, {args.n:,} pairs, binary file to files | {a['file_to_file']:.3f} s (load {a['load']:.3f} + "
+          f"solve {a['solve']:.3f} on {args.threads} threads + save {a['save']:.3f}) | {a['dask']:.3f} s "
+          f"({args.workers} workers, all included) | {a['file_to_file'] / a['dask']:.2f} of in-process throughput "
+          f"({a['solve'] / a['dask']:.3f} of the solve alone) |")
     print(f"| {args.scenes} scenes of {args.scene_n:,} contacts | {b[1]:.2f} s (1 worker) | {b[args.workers]:.2f} s "
           f"({args.workers} workers) | {b[1] / b[args.workers]:.2f} (1 worker / {args.workers}) |")
     return 0 if same else 1

@@ -14,6 +14,10 @@
 //   what the file readers refuse, with their reason; the message names the
 //   body and the column, "from_physical: body 3, column 'm': mass must be
 //   > 0, got -1". The inverses are the readers' too (inverses_of).
+// * inverses gives those inverses alone, without the rules and without a
+//   copy of anything else: for a caller that holds columns a reader has
+//   already checked (collide.dask's workers, over their rows of a file the
+//   client loaded).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -177,6 +181,37 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
   });
 }
 
+/// 1/m and 1/I as the readers compute them (inverses_of), for columns that
+/// have passed the rules: (inv_mass (N,), inv_inertia (3, N)). Any value is
+/// safe (a division, no index), but only checked columns give the scene's
+/// meaning.
+py::tuple inverses_py(const py::object& m_in, const py::object& inertia_in) {
+  const std::string owner = "inverses";
+  const Dtype d = scene_dtype("inverses.m", m_in);
+  const py::dtype dt = numpy_dtype(d);
+  const char* dn = dtype_name(d);
+  const py::array m = checked_array(owner, "m", m_in, dt, dn, 0, false);
+  const py::array I = checked_array(owner, "inertia", inertia_in, dt, dn, 3, false);
+  const std::size_t n = length(m);
+  require_length(owner, "inertia", I, n, "m");
+  return with_dtype(d, [&](auto tag) {
+    using T = decltype(tag);
+    BodyColumns<T> columns;  // only m and I are read
+    columns.count = n;
+    columns.column[0] = data<T>(m);
+    for (py::ssize_t k = 0; k < 3; ++k) columns.column[static_cast<std::size_t>(1 + k)] = row<T>(I, k);
+    py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
+    py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
+    {
+      T* const im = data<T>(inv_mass);
+      const Vec3Array<T> ii = vec3<T>(inv_inertia);
+      py::gil_scoped_release release;
+      inverses_of(columns, im, ii);
+    }
+    return py::make_tuple(inv_mass, inv_inertia);
+  });
+}
+
 /// model "auto" of a solve: the cheapest model that fits the validated scene.
 std::string choose_model_py(const Bodies& bodies, const Contacts& contacts) {
   require_same_dtype(bodies, contacts);
@@ -233,6 +268,7 @@ void register_scene(py::module_& m) {
         py::arg("dtype") = py::none());
   m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
         py::arg("w"), py::arg("dtype"));
+  m.def("inverses", &inverses_py, py::arg("m"), py::arg("inertia"));
   m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"));
   m.def("model_misfit", &model_misfit_py, py::arg("bodies"), py::arg("contacts"), py::arg("model"));
 }

@@ -149,24 +149,66 @@ def test_scene_files_same_bytes_written_in_place(client, tmp_path, model, dtype,
                    expected32)
 
 
+def chained_scenes(*parts):
+    """The scenes ``parts`` one after the other: bodies and contacts
+    concatenated in order, each part's indices shifted past the bodies
+    before it (each part keeps its own islands)."""
+    offsets = np.cumsum([0] + [len(b) for b, _ in parts])
+    bodies = collide.Bodies(*(np.ascontiguousarray(np.concatenate([getattr(b, f) for b, _ in parts], axis=-1))
+                              for f in FIELDS))
+    cat = lambda name: np.ascontiguousarray(np.concatenate([getattr(c, name) for _, c in parts], axis=-1))  # noqa: E731
+    a = np.concatenate([c.a + o for (_, c), o in zip(parts, offsets)]).astype(np.uint32)
+    b = np.concatenate([c.b + o for (_, c), o in zip(parts, offsets)]).astype(np.uint32)
+    return bodies, collide.Contacts(a, b, cat("c"), cat("n"), cat("e"))
+
+
+def test_scene_files_partitions_of_rows_out_of_order(client, tmp_path):
+    # Two chains, the later one longer: the greedy puts the larger island on
+    # the first partition, so partition 0 holds the last rows of the file
+    # and partition 1 the first ones, each a range of rows, and the workers
+    # must read those rows, not the partitions' positions.
+    bodies, contacts = chained_scenes(collide.generate("chain", 40, seed=2), collide.generate("chain", 90, seed=3))
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    expected = reference_bytes(*collide.load(bp, cp))
+    solution = cd.solve((bp, cp), client, out_dir=tmp_path / "out", partitions=2)
+    assert solution.stats["partitions"] == [90, 40]
+    same_bytes(solution, expected)
+
+
 def test_workers_map_the_members_of_scene_files(tmp_path):
-    from collide.dask._files import npz_columns
+    from collide.dask._files import MappedNpz
 
     bodies, contacts = collide.generate("debris", 500, friction=True, dtype=np.float32)
     bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
     collide.save(bp, cp, bodies, contacts)
     np.savez(tmp_path / "numpy.npz", x=np.arange(7, dtype=np.int64), empty=np.zeros(0))
     for path in (bp, cp, tmp_path / "numpy.npz"):
-        columns = npz_columns(path)
+        mapped = MappedNpz(path)
         with np.load(path) as z:
-            assert sorted(columns) == sorted(z.files)
+            assert sorted(mapped.columns) == sorted(z.files)
             for name in z.files:
-                assert columns[name].dtype == z[name].dtype and columns[name].tobytes() == z[name].tobytes(), name
-                assert isinstance(columns[name], np.memmap) or columns[name].size == 0
-                assert not columns[name].flags.writeable or columns[name].size == 0
+                column = mapped[name]
+                assert column.dtype == z[name].dtype and column.tobytes() == z[name].tobytes(), name
+                assert not column.flags.writeable, name
+    # Rows of members one stride apart: a range is a view of the mapping,
+    # anything else (rows picked, another dtype) a new array; the values
+    # are the members' either way.
+    mapped = MappedNpz(bp)
+    with np.load(bp) as z:
+        v = np.stack([z["vx"], z["vy"], z["vz"]])
+        view = mapped.stacked(("vx", "vy", "vz"), slice(10, 90), np.float32)
+        assert view.base is not None and not view.flags.writeable and not view.flags.owndata
+        assert view.tobytes() == v[:, 10:90].tobytes()
+        picked = np.array([3, 1, 200, 7], dtype=np.int64)
+        gathered = mapped.stacked(("vx", "vy", "vz"), picked, np.float32)
+        assert gathered.flags.owndata and gathered.tobytes() == v[:, picked].tobytes()
+        wide = mapped.stacked(("vx", "vy", "vz"), slice(10, 90), np.float64)
+        assert wide.flags.owndata and wide.tobytes() == v[:, 10:90].astype(np.float64).tobytes()
+        assert mapped.stacked(("m",), slice(5, 5), np.float32).shape == (1, 0)
     np.savez_compressed(tmp_path / "z.npz", x=np.arange(7))
     with pytest.raises(ValueError, match=r"z\.npz: member 'x\.npy' is compressed"):
-        npz_columns(tmp_path / "z.npz")
+        MappedNpz(tmp_path / "z.npz")
 
 
 def test_partition_islands_is_a_balanced_deterministic_greedy():

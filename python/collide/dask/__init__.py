@@ -164,7 +164,9 @@ def _warn_if_giant(figures, contacts, stacklevel):
 def _partitions(isl, requested, client):
     """The contacts grouped by partition, ascending inside each (the scene's
     order), and the contacts of each partition and where its group ends:
-    ``(order, counts, ends)``."""
+    ``(order, counts, ends)``. ``order`` is None when the groups are already
+    in the scene's order (partition 0 the first contacts, and so on: a scene
+    of many small islands), so that positions in it are contact rows."""
     p = requested if requested is not None else max(1, sum(client.nthreads().values()))
     if int(p) < 1:
         raise ValueError(f"partitions must be >= 1, got {p}")
@@ -174,7 +176,22 @@ def _partitions(isl, requested, client):
     dtype = np.uint8 if used <= 256 else np.uint16 if used <= 65536 else np.uint32
     contact_part = island_part.astype(dtype)[isl.labels]
     counts = np.bincount(contact_part, minlength=used)
-    return np.argsort(contact_part, kind="stable"), counts, np.cumsum(counts)
+    ends = np.cumsum(counts)
+    if len(contact_part) < 2 or bool(np.all(contact_part[1:] >= contact_part[:-1])):
+        return None, counts, ends
+    return np.argsort(contact_part, kind="stable"), counts, ends
+
+
+def _rows(order, count, end):
+    """The contact rows of the partition whose group ends at position
+    ``end`` of ``order``: a slice where they are consecutive, else an
+    int64 array."""
+    if order is None:
+        return slice(int(end - count), int(end))
+    rows = order[end - count:end]
+    if int(rows[-1]) - int(rows[0]) == count - 1:
+        return slice(int(rows[0]), int(rows[0]) + int(count))
+    return rows
 
 
 def _is_scene_files(scene):
@@ -223,7 +240,8 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     islands, largest_island, largest_island_share, partitions (their contact
     counts), model, precision, accuracy, seconds (the whole call),
     collisions_per_second (collisions / seconds), islands_seconds,
-    kernel_seconds (the partitions' solves, summed), and for files
+    kernel_seconds (the partitions' solves, summed), partition_seconds
+    (each partition's task on its worker, read to write), and for files
     read_seconds (the load and check on the client)."""
     started = time.perf_counter()
     options = _options(model, accuracy, threads, isa)
@@ -253,7 +271,8 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
             "model": scene_model, "precision": "float" if precision == np.float32 else "double",
             "accuracy": options["accuracy"], "seconds": seconds,
             "collisions_per_second": collisions / seconds if seconds > 0 else 0.0,
-            "kernel_seconds": sum(r["kernel_seconds"] for r in results), **extra}
+            "kernel_seconds": sum(r["kernel_seconds"] for r in results),
+            "partition_seconds": [r["seconds"] for r in results], **extra}
 
 
 def _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started):
@@ -271,7 +290,7 @@ def _solve_arrays(bodies, contacts, client, partitions, options, workers, progre
             for p, count in enumerate(counts):
                 if count == 0:
                     continue
-                rows = order[ends[p] - count:ends[p]]
+                rows = _rows(order, count, ends[p])
                 sub_bodies, sub_contacts, ids = _tasks.sub_scene(bodies, contacts, rows)
                 payload = {"bodies": [getattr(sub_bodies, f) for f in ("inv_mass", "inv_inertia", "q", "p", "v", "w")],
                            "contacts": [sub_contacts.a, sub_contacts.b, sub_contacts.c, sub_contacts.n, sub_contacts.e,
@@ -308,34 +327,39 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
     n, m = len(bodies), len(contacts)
     precision = bodies.dtype
     try:
-        # The outputs, allocated here; v and w start as the input's, so a
-        # body no contact moves (or an immovable one) keeps its values.
+        # The outputs, allocated here. The workers write J and the v, w of
+        # every body a contact names; the client writes the input values of
+        # the bodies in no island (no contact names them, or they are
+        # immovable: their values, whoever writes them), if there are any.
         j = np.lib.format.open_memmap(partial["J"], mode="w+", dtype=precision, shape=(3, m))
         del j
+        unnamed = np.flatnonzero(isl.body_labels == collide.Islands.NONE)
         for k in ("v", "w"):
             out = np.lib.format.open_memmap(partial[k], mode="w+", dtype=precision, shape=(3, n))
-            out[...] = getattr(bodies, k)
+            if len(unnamed):
+                out[:, unnamed] = getattr(bodies, k)[:, unnamed]
             out.flush()
             del out
         common = {"bodies_path": bodies_path, "contacts_path": contacts_path, "body_count": n, "dtype": precision.name,
                   "friction": contacts.mu is not None, "outputs": partial}
         with _connected(client, workers) as c:
             order, counts, ends = _partitions(isl, partitions, c)
-            # Partitions of consecutive contacts (a scene of independent
-            # pairs) are sent as ranges; otherwise the workers read their
-            # rows from an order file beside the outputs.
-            consecutive = all(count == 0 or int(order[e - 1]) - int(order[e - count]) == count - 1
-                              for count, e in zip(counts, ends))
-            if not consecutive:
+            # A partition of consecutive contacts (a scene of independent
+            # pairs: all of them) is sent as its range of rows; the others
+            # read their rows from an order file beside the outputs.
+            rows = [_rows(order, count, e) if count else None for count, e in zip(counts, ends)]
+            if any(isinstance(r, np.ndarray) for r in rows):
                 np.save(order_path, order.astype(np.uint32))
-            del bodies, contacts, isl, order
+            del bodies, contacts, isl, order, unnamed
             key = f"collide-dask-part-{uuid.uuid4().hex}"
             futures = []
-            for p, count in enumerate(counts):
+            for p, (count, e, r) in enumerate(zip(counts, ends, rows)):
                 if count == 0:
                     continue
-                first = int(ends[p] - count)
-                part = dict(common, order=None if consecutive else order_path, first=first, end=first + int(count))
+                if isinstance(r, slice):
+                    part = dict(common, order=None, first=r.start, end=r.stop)
+                else:
+                    part = dict(common, order=order_path, first=int(e - count), end=int(e))
                 futures.append(c.submit(_tasks.solve_part_files, part, task, key=f"{key}-{p}", pure=False))
             results = _wait(futures, progress, "partitions")
         for k in final:

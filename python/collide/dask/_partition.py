@@ -35,7 +35,7 @@ def partition_islands(sizes, partitions):
     ``[0, partitions)``. At most ``partitions`` are used, and no more than
     there are islands; some may stay empty when a few large islands hold
     everything. Deterministic: the same sizes give the same partitions."""
-    sizes = np.asarray(sizes, dtype=np.int64)
+    sizes = np.asarray(sizes)
     if sizes.ndim != 1:
         raise ValueError(f"partition_islands: sizes must be 1-D, got shape {sizes.shape}")
     if int(partitions) < 1:
@@ -45,13 +45,12 @@ def partition_islands(sizes, partitions):
     p = max(1, min(int(partitions), count))
     if count == 0 or p == 1:
         return parts
-    target = sizes.sum() / p
-    large = sizes > target * LARGE_FRACTION
+    target = int(sizes.sum(dtype=np.int64)) / p
+    large_ids = np.flatnonzero(sizes > target * LARGE_FRACTION)
     load = np.zeros(p, dtype=np.float64)
-    large_ids = np.flatnonzero(large)
     if len(large_ids):
         # Largest first; a stable sort keeps the lower label first among equals.
-        order = large_ids[np.argsort(-sizes[large_ids], kind="stable")]
+        order = large_ids[np.argsort(-sizes[large_ids].astype(np.int64), kind="stable")]
         heap = [(0, k) for k in range(p)]
         for island in order:
             contacts, k = heapq.heappop(heap)
@@ -59,13 +58,20 @@ def partition_islands(sizes, partitions):
             contacts += int(sizes[island])
             load[k] = contacts
             heapq.heappush(heap, (contacts, k))
-    small_ids = np.flatnonzero(~large)
-    if len(small_ids):
+    # The small islands (all of them, in a scene of many: no copy then).
+    small_ids = slice(None) if len(large_ids) == 0 else np.flatnonzero(sizes <= target * LARGE_FRACTION)
+    small = sizes[small_ids]
+    if len(small):
         # Partition k takes the small islands whose first contact, counted
         # through the small islands in label order, falls in its share of
-        # the room left below the mean.
+        # the room left below the mean: island i goes to the number of
+        # shares that end at or before its start. The starts ascend, so
+        # each share's first island is one binary search.
         room = np.maximum(target - load, 0.0)
         ends = np.cumsum(room)
-        starts = np.cumsum(sizes[small_ids]) - sizes[small_ids]
-        parts[small_ids] = np.minimum(np.searchsorted(ends, starts, side="right"), p - 1)
+        starts = np.cumsum(small, dtype=np.int64)
+        starts -= small
+        firsts = np.searchsorted(starts, ends[:p - 1], side="left")
+        small_parts = np.repeat(np.arange(p, dtype=np.int64), np.diff(firsts, prepend=0, append=len(small)))
+        parts[small_ids] = small_parts
     return parts

@@ -4,12 +4,13 @@ called (and tested) without Dask; the workers import them by name.
 
 A partition is a set of whole islands. It is solved as a scene of its own:
 its contacts in input order, its bodies (every body its contacts name,
-immovable ones included, as read-only copies) in ascending index order, the
-contacts' indices remapped to them. Islands never see each other's results,
-so the impulses and the velocities of its movable bodies are bit for bit
-those of one solve of the whole scene (collide/islands.hpp). Only movable
-bodies are written back: an immovable body may be named by several
-partitions, and the solver never changes it.
+immovable ones included) in ascending index order, the contacts' indices
+remapped to them. Islands never see each other's results, so the impulses
+and the velocities of its movable bodies are bit for bit those of one solve
+of the whole scene (collide/islands.hpp). An immovable body may be named by
+several partitions; the solver never changes it, so a partition sent as
+arrays returns its movable bodies only, and one of a file writes every body
+it names (an immovable one with its input values, whoever writes it).
 """
 
 from __future__ import annotations
@@ -20,44 +21,44 @@ import numpy as np
 
 import collide
 
-from ._files import npz_columns
+from ._files import MappedNpz
 
-BODY_COLUMNS = ("m", "Ix", "Iy", "Iz", "qw", "qx", "qy", "qz", "px", "py", "pz", "vx", "vy", "vz", "wx", "wy", "wz")
-CONTACT_REALS = ("cx", "cy", "cz", "nx", "ny", "nz", "e", "mu")
-
-
-def local_bodies(a, b, body_count):
-    """The bodies contacts ``a``, ``b`` name, ascending, and the contacts'
-    indices into that list (uint32): ``(bodies, a_local, b_local)``."""
+def local_bodies(a, b):
+    """The bodies contacts ``a``, ``b`` (uint32) name, ascending, and the
+    contacts' indices into that list (uint32): ``(bodies, a_local,
+    b_local)``. ``bodies`` is a slice when the named bodies are a range of
+    consecutive indices (independent pairs: then a worker's body rows are
+    views, and its v and w are solved in place), else an int64 array."""
     m = len(a)
-    if m * 8 < body_count:
-        # A few contacts among many bodies: sort what is named.
+    if m == 0:
+        return slice(0, 0), a, b
+    first = int(min(a.min(), b.min()))
+    span = int(max(a.max(), b.max())) + 1 - first
+    if m * 8 < span:
+        # A few contacts spread over many bodies: sort what is named.
         bodies, inverse = np.unique(np.concatenate([a, b]), return_inverse=True)
         inverse = inverse.astype(np.uint32)
-        return bodies, inverse[:m], inverse[m:]
-    # Linear in the body count: mark, list, number.
-    named = np.zeros(body_count, dtype=bool)
-    named[a] = True
-    named[b] = True
+        return bodies.astype(np.int64), inverse[:m], inverse[m:]
+    # Linear in the span of the indices: mark, list, number.
+    a0, b0 = a - np.uint32(first), b - np.uint32(first)
+    named = np.zeros(span, dtype=bool)
+    named[a0] = True
+    named[b0] = True
+    if named.all():
+        return slice(first, first + span), a0, b0
     bodies = np.flatnonzero(named)
-    number = np.empty(body_count, dtype=np.uint32)
+    number = np.empty(span, dtype=np.uint32)
     number[bodies] = np.arange(len(bodies), dtype=np.uint32)
-    return bodies, number[a], number[b]
-
-
-def take(column, rows):
-    """column[rows], as a slice when the rows are consecutive (a sequential
-    read of a mapped file) and as a gather otherwise."""
-    if len(rows) and int(rows[-1]) - int(rows[0]) + 1 == len(rows):
-        return np.array(column[int(rows[0]):int(rows[-1]) + 1])
-    return np.asarray(column[rows])
+    return bodies + first, number[a0], number[b0]
 
 
 def sub_scene(bodies, contacts, rows):
     """Contacts ``rows`` (ascending) of a scene of arrays and the bodies they
     name, as a new scene over copies: ``(Bodies, Contacts, body_ids)``."""
     a, b = contacts.a[rows], contacts.b[rows]
-    ids, la, lb = local_bodies(a, b, len(bodies))
+    ids, la, lb = local_bodies(a, b)
+    if isinstance(ids, slice):
+        ids = np.arange(ids.start, ids.stop, dtype=np.int64)
     sub_bodies = collide.Bodies(*(np.ascontiguousarray(getattr(bodies, f)[..., ids])
                                   for f in ("inv_mass", "inv_inertia", "q", "p", "v", "w")))
     optional = {k: (None if getattr(contacts, k) is None else np.ascontiguousarray(getattr(contacts, k)[rows]))
@@ -68,11 +69,11 @@ def sub_scene(bodies, contacts, rows):
     return sub_bodies, sub_contacts, ids
 
 
-def _solve(bodies, contacts, options):
+def _solve(bodies, contacts, options, out=None):
     """collide.solve of an already checked scene (the client ran the checks
-    on the whole scene and chose the model there)."""
+    on the whole scene and chose the model there); J into ``out`` if given."""
     return collide.solve(bodies, contacts, model=options["model"], accuracy=options["accuracy"],
-                         threads=options["threads"], isa=options["isa"], check=False, impacts=False)
+                         threads=options["threads"], isa=options["isa"], out=out, check=False, impacts=False)
 
 
 def _part_stats(stats, contacts, bodies, started, read_seconds):
@@ -95,50 +96,56 @@ def solve_part_arrays(part, options):
 
 
 def contact_rows(part):
-    """The contact rows of a partition of a scene file: a range, or a slice
-    of the order file the client wrote."""
+    """The contact rows of a partition of a scene file: a slice, or rows of
+    the order file the client wrote (int64)."""
     if part["order"] is None:
-        return np.arange(part["first"], part["end"], dtype=np.int64)
+        return slice(part["first"], part["end"])
     order = np.load(part["order"], mmap_mode="r")
     return np.array(order[part["first"]:part["end"]], dtype=np.int64)
 
 
-def read_part(part):
-    """The partition's scene read from the mapped scene files: ``(Bodies,
-    Contacts, rows, body_ids)``."""
+def solve_part_files(part, options):
+    """A partition of a scene file: reads its rows from the mapped scene
+    files, solves them, and writes its J and the v, w of every body it names
+    in place into the output .npy files the client allocated (an immovable
+    body named by several partitions is written by each with its input
+    values: the same bytes). Where the partition's contacts, or its bodies,
+    are a range of rows (independent pairs), they are read as views of the
+    mapping and J, or v and w, solved in place in the outputs: no copy but
+    the one of v and w into their output. Writing the same values again (a
+    task run again after its worker was lost) gives the same bytes. Returns
+    stats."""
+    started = time.perf_counter()
     dtype = np.dtype(part["dtype"])
     rows = contact_rows(part)
-    cols = npz_columns(part["contacts_path"])
-    a = take(cols["a"], rows).astype(np.uint32, copy=False)
-    b = take(cols["b"], rows).astype(np.uint32, copy=False)
-    ids, la, lb = local_bodies(a, b, part["body_count"])
-    real = {k: take(cols[k], rows).astype(dtype, copy=False) for k in CONTACT_REALS}
-    contacts = collide.Contacts(la, lb, np.stack([real["cx"], real["cy"], real["cz"]]),
-                                np.stack([real["nx"], real["ny"], real["nz"]]), real["e"],
-                                mu=real["mu"] if part["friction"] else None)
-    bcols = npz_columns(part["bodies_path"])
-    x = [take(bcols[k], ids).astype(dtype, copy=False) for k in BODY_COLUMNS]
+    cfile, bfile = MappedNpz(part["contacts_path"]), MappedNpz(part["bodies_path"])
+    a = np.asarray(cfile["a"][rows]).astype(np.uint32, copy=False)
+    b = np.asarray(cfile["b"][rows]).astype(np.uint32, copy=False)
+    ids, la, lb = local_bodies(a, b)
+    contacts = collide.Contacts(la, lb, cfile.stacked(("cx", "cy", "cz"), rows, dtype),
+                                cfile.stacked(("nx", "ny", "nz"), rows, dtype), cfile.stacked(("e",), rows, dtype)[0],
+                                mu=cfile.stacked(("mu",), rows, dtype)[0] if part["friction"] else None)
     # The inverses as collide.load computes them (the readers' own code).
-    bodies = collide.from_physical(x[0], np.stack(x[1:4]), np.stack(x[4:8]), np.stack(x[8:11]), np.stack(x[11:14]),
-                                   np.stack(x[14:17]), dtype=dtype)
-    return bodies, contacts, rows, ids
-
-
-def solve_part_files(part, options):
-    """A partition of a scene file: reads its rows, solves them, and writes
-    its J and the v, w of its movable bodies in place into the output .npy
-    files the client allocated. Writing the same values again (a task run
-    again after its worker was lost) gives the same bytes. Returns stats."""
-    started = time.perf_counter()
-    bodies, contacts, rows, ids = read_part(part)
-    read_seconds = time.perf_counter() - started
-    J, stats = _solve(bodies, contacts, options)
+    inv_mass, inv_inertia = collide._collide.inverses(bfile.stacked(("m",), ids, dtype)[0],
+                                                      bfile.stacked(("Ix", "Iy", "Iz"), ids, dtype))
     out = {k: np.load(part["outputs"][k], mmap_mode="r+") for k in ("J", "v", "w")}
-    consecutive = len(rows) and int(rows[-1]) - int(rows[0]) + 1 == len(rows)
-    out["J"][:, slice(int(rows[0]), int(rows[-1]) + 1) if consecutive else rows] = J
-    movable = bodies.inv_mass != 0
-    out["v"][:, ids[movable]] = bodies.v[:, movable]
-    out["w"][:, ids[movable]] = bodies.w[:, movable]
+    vw = {}
+    for k in ("v", "w"):
+        names = tuple(k + axis for axis in "xyz")
+        if isinstance(ids, slice):
+            vw[k] = out[k][:, ids]
+            vw[k][...] = bfile.stacked(names, ids, dtype)
+        else:
+            vw[k] = bfile.stacked(names, ids, dtype)
+    bodies = collide.Bodies(inv_mass, inv_inertia, bfile.stacked(("qw", "qx", "qy", "qz"), ids, dtype),
+                            bfile.stacked(("px", "py", "pz"), ids, dtype), vw["v"], vw["w"])
+    read_seconds = time.perf_counter() - started
+    J, stats = _solve(bodies, contacts, options, out=out["J"][:, rows] if isinstance(rows, slice) else None)
+    if not isinstance(rows, slice):
+        out["J"][:, rows] = J
+    if not isinstance(ids, slice):
+        out["v"][:, ids] = vw["v"]
+        out["w"][:, ids] = vw["w"]
     for array in out.values():
         array.flush()
     return _part_stats(stats, len(contacts), len(bodies), started, read_seconds)
