@@ -212,12 +212,21 @@ py::tuple inverses_py(const py::object& m_in, const py::object& inertia_in) {
   });
 }
 
-/// model "auto" of a solve: the cheapest model that fits the validated scene.
-std::string choose_model_py(const Bodies& bodies, const Contacts& contacts) {
+/// model "auto" of a solve: the cheapest model that fits the scene, after
+/// validate() (check=false: the caller has validated these very arrays, as
+/// collide.load does; indices are checked either way, the choice reads the
+/// bodies of every contact).
+std::string choose_model_py(const Bodies& bodies, const Contacts& contacts, bool check) {
   require_same_dtype(bodies, contacts);
   return with_dtype(bodies.dtype, [&](auto tag) {
     using T = decltype(tag);
-    validate_or_throw<T>(bodies, contacts);
+    if (check) {
+      validate_or_throw<T>(bodies, contacts);
+    } else if (const Validation v = validate_indices(contacts.view<T>().a, contacts.view<T>().b, contacts.count,
+                                                     bodies.count);
+               !v) {
+      throw py::value_error(v.message);
+    }
     return std::string(to_string(choose_model(bodies.view<T>(), contacts.view<T>())));
   });
 }
@@ -269,7 +278,7 @@ void register_scene(py::module_& m) {
   m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
         py::arg("w"), py::arg("dtype"));
   m.def("inverses", &inverses_py, py::arg("m"), py::arg("inertia"));
-  m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"));
+  m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"), py::arg("check") = true);
   m.def("model_misfit", &model_misfit_py, py::arg("bodies"), py::arg("contacts"), py::arg("model"));
 }
 

@@ -153,6 +153,24 @@ def test_unchecked_solve_still_checks_indices(kind):
         assert np.array_equal(arrays[f], before[f]), f
 
 
+@pytest.mark.parametrize("kind", ["index", "self"])
+def test_unchecked_model_choice_still_checks_indices(kind):
+    # collide.dask's client chooses the model of a loaded scene without a
+    # second pass of the rules, never without the index check.
+    arrays, carrays, message = corrupt(kind)
+    b, c = make(arrays, carrays)
+    with pytest.raises(ValueError, match=message):
+        collide._collide.choose_model(b, c, check=False)
+    with pytest.raises(ValueError, match=message):
+        collide._collide.choose_model(b, c)
+    arrays, carrays = scene()
+    arrays["v"][0, 3] = np.nan
+    b, c = make(arrays, carrays)
+    with pytest.raises(ValueError, match=r"v.*3"):
+        collide._collide.choose_model(b, c)
+    assert collide._collide.choose_model(b, c, check=False) == "rigid"
+
+
 def test_unchecked_solve_is_the_same_solve():
     bodies, contacts = collide.generate("debris", 3000, friction=True, dtype=np.float32)
     v0, w0 = bodies.v.copy(), bodies.w.copy()

@@ -176,6 +176,36 @@ def test_scene_files_partitions_of_rows_out_of_order(client, tmp_path):
     same_bytes(solution, expected)
 
 
+@pytest.mark.parametrize("elsewhere", [False, True])
+def test_a_partition_task_alone_writes_its_rows(tmp_path, elsewhere):
+    # The task without Dask, as a worker runs it, on the client's machine
+    # (no flush) or on another one (flushed): two partitions, one of a range
+    # of rows (read as views, solved in place) and one read through an
+    # order file, give the whole solve's bytes.
+    from collide.dask import _tasks
+
+    bodies, contacts = chained_scenes(collide.generate("pairs", 50, seed=5), island_scene(seed=9))
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    expected = reference_bytes(*collide.load(bp, cp))
+    outputs = {k: str(tmp_path / f"{k}.npy") for k in "Jvw"}
+    np.lib.format.open_memmap(outputs["J"], mode="w+", dtype=np.float64, shape=(3, len(contacts)))
+    unnamed = np.flatnonzero(collide.islands(bodies, contacts).body_labels == collide.Islands.NONE)
+    for k in "vw":
+        out = np.lib.format.open_memmap(outputs[k], mode="w+", dtype=np.float64, shape=(3, len(bodies)))
+        out[:, unnamed] = getattr(bodies, k)[:, unnamed]
+        out.flush()
+        del out
+    order = np.arange(50, len(contacts), dtype=np.uint32)
+    np.save(tmp_path / "order.npy", order)
+    common = {"bodies_path": bp, "contacts_path": cp, "body_count": len(bodies), "dtype": "float64", "friction": False,
+              "outputs": outputs, "client_machine": "another kernel" if elsewhere else _tasks.machine()}
+    options = {"model": expected[3]["model"], "accuracy": "fast", "threads": 1, "isa": None}
+    _tasks.solve_part_files(dict(common, order=None, first=0, end=50), options)
+    _tasks.solve_part_files(dict(common, order=str(tmp_path / "order.npy"), first=0, end=len(order)), options)
+    same_bytes(cd.Solution(*(np.load(outputs[k]) for k in "Jvw"), {}), expected)
+
+
 def test_workers_map_the_members_of_scene_files(tmp_path):
     from collide.dask._files import MappedNpz
 

@@ -124,12 +124,14 @@ def _options(model, accuracy, threads, isa, sample=0):
     return {"model": model, "accuracy": accuracy, "threads": int(threads), "isa": isa, "sample": int(sample)}
 
 
-def _scene_model(bodies, contacts, model):
+def _scene_model(bodies, contacts, model, loaded):
     """The model the whole scene runs, after every value of it is checked by
-    the library's validate() (ValueError naming the array and the element):
-    the model collide.solve would run. Partitions run this model, not their
-    own cheapest, which could differ from the whole scene's."""
-    chosen = collide._collide.choose_model(bodies, contacts)
+    the library's validate() (ValueError naming the array and the element;
+    ``loaded``: the arrays come from collide.load, whose reader checked
+    every value, so only the indices are checked again): the model
+    collide.solve would run. Partitions run this model, not their own
+    cheapest, which could differ from the whole scene's."""
+    chosen = collide._collide.choose_model(bodies, contacts, check=not loaded)
     if model == "auto":
         return chosen
     misfit = collide._collide.model_misfit(bodies, contacts, model)
@@ -138,11 +140,11 @@ def _scene_model(bodies, contacts, model):
     return model
 
 
-def _prepare(bodies, contacts, options):
+def _prepare(bodies, contacts, options, loaded=False):
     """What the client does before any task: checks the scene and chooses
     its model, computes its islands and warns about a giant one. Returns the
     options of the tasks, the islands, their figures and their time."""
-    task = dict(options, model=_scene_model(bodies, contacts, options["model"]))
+    task = dict(options, model=_scene_model(bodies, contacts, options["model"], loaded))
     t = time.perf_counter()
     isl = collide.islands(bodies, contacts)
     islands_seconds = time.perf_counter() - t
@@ -318,7 +320,7 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
     t = time.perf_counter()
     bodies, contacts = collide.load(bodies_path, contacts_path, dtype=dtype)
     read_seconds = time.perf_counter() - t
-    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options)
+    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options, loaded=True)
     os.makedirs(out_dir, exist_ok=True)
     out_dir = os.path.abspath(out_dir)
     final = {k: os.path.join(out_dir, f"{k}.npy") for k in ("J", "v", "w")}
@@ -341,7 +343,7 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
             out.flush()
             del out
         common = {"bodies_path": bodies_path, "contacts_path": contacts_path, "body_count": n, "dtype": precision.name,
-                  "friction": contacts.mu is not None, "outputs": partial}
+                  "friction": contacts.mu is not None, "outputs": partial, "client_machine": _tasks.machine()}
         with _connected(client, workers) as c:
             order, counts, ends = _partitions(isl, partitions, c)
             # A partition of consecutive contacts (a scene of independent
