@@ -35,6 +35,8 @@
 #include <variant>
 #include <vector>
 
+#include <oneapi/tbb/global_control.h>
+
 #include "bindings.hpp"
 #include "collide/eval/check.hpp"
 #include "collide/eval/conservation.hpp"
@@ -291,6 +293,24 @@ py::dict conservation_drift_py(const Bodies& bodies, const Reference& ref) {
 
 }  // namespace
 
+/// At most `threads` threads in every parallel loop of the process while
+/// held (a `with` block): generate, load, islands and the solvers alike
+/// (tbb::global_control). For a process that is given a share of a
+/// machine, such as a Dask worker of one thread, which would otherwise
+/// compete with its neighbours for every core.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads) : threads_(threads) {
+    if (threads < 1) throw py::value_error("ThreadLimit: threads must be >= 1, got " + std::to_string(threads));
+  }
+  void enter() { control_.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_)); }
+  void exit() { control_.reset(); }
+
+ private:
+  int threads_;
+  std::optional<tbb::global_control> control_;
+};
+
 void register_solve(py::module_& m) {
   py::class_<PySchedule>(m, "Schedule")
       .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"))
@@ -312,6 +332,14 @@ void register_solve(py::module_& m) {
       .def("solve", &PySolver::solve<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
            py::arg("check") = true, py::arg("impacts") = true);
+
+  py::class_<ThreadLimit>(m, "ThreadLimit")
+      .def(py::init<int>(), py::arg("threads"))
+      .def("__enter__", [](ThreadLimit& t) -> ThreadLimit& {
+             t.enter();
+             return t;
+           }, py::return_value_policy::reference)
+      .def("__exit__", [](ThreadLimit& t, const py::args&) { t.exit(); });
 
   py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
       .def_property_readonly("J", &Reference::j_array)

@@ -7,6 +7,7 @@ import time
 import tracemalloc
 
 import numpy as np
+import pytest
 
 import collide
 
@@ -72,3 +73,21 @@ def test_no_reference_or_memory_leaks():
     growth = sum(s.size_diff for s in snap1.compare_to(snap0, "filename"))
     # 200 iterations of a J of 24 kB each: a leaked array per call would be 4.8 MB.
     assert growth < 100_000, growth
+
+
+def test_thread_limit_keeps_the_results():
+    # collide.dask runs each task under ThreadLimit(its threads): generate,
+    # islands and solve on one thread give the bytes they give on all.
+    def run():
+        bodies, contacts = collide.generate("debris", 200_000, friction=True, dtype=np.float32)
+        labels = collide.islands(bodies, contacts).labels.copy()
+        J, _ = collide.solve(bodies, contacts)
+        return bodies.v.tobytes(), bodies.w.tobytes(), J.tobytes(), labels.tobytes()
+
+    everywhere = run()
+    with collide._collide.ThreadLimit(1):
+        assert run() == everywhere
+    assert run() == everywhere
+    for bad in (0, -1):
+        with pytest.raises(ValueError, match="threads must be >= 1"):
+            collide._collide.ThreadLimit(bad)

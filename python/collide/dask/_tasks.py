@@ -15,6 +15,8 @@ it names (an immovable one with its input values, whoever writes it).
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import time
 
 import numpy as np
@@ -69,6 +71,22 @@ def sub_scene(bodies, contacts, rows):
     return sub_bodies, sub_contacts, ids
 
 
+def on_its_threads(task):
+    """A task ``task(x, options)`` run on its share of the machine: at most
+    ``options["threads"]`` threads in every parallel loop of the library
+    (generate, load, islands, the solvers) while it runs; 0: all of them.
+    A Dask worker of one thread then keeps to one core instead of competing
+    with its neighbours for every core."""
+
+    @functools.wraps(task)
+    def run(x, options):
+        threads = options["threads"]
+        with collide._collide.ThreadLimit(threads) if threads > 0 else contextlib.nullcontext():
+            return task(x, options)
+
+    return run
+
+
 def _solve(bodies, contacts, options, out=None):
     """collide.solve of an already checked scene (the client ran the checks
     on the whole scene and chose the model there); J into ``out`` if given."""
@@ -82,6 +100,7 @@ def _part_stats(stats, contacts, bodies, started, read_seconds):
             "read_seconds": read_seconds, "seconds": time.perf_counter() - started}
 
 
+@on_its_threads
 def solve_part_arrays(part, options):
     """A partition sent as arrays (``solve`` of a scene in memory): returns
     ``(J, v, w, movable, stats)``, v and w of its movable bodies only, whose
@@ -115,6 +134,7 @@ def contact_rows(part):
     return np.array(order[part["first"]:part["end"]], dtype=np.int64)
 
 
+@on_its_threads
 def solve_part_files(part, options):
     """A partition of a scene file: reads its rows from the mapped scene
     files, solves them, and writes its J and the v, w of every body it names
@@ -183,6 +203,7 @@ def scene_of(entry):
     return collide.generate(kind, n, **spec)
 
 
+@on_its_threads
 def scene_row(entry, options):
     """Solves one scene on the worker and measures it: the row of
     ``solve_scenes``. The error and the drifts are measured on the scene's
