@@ -241,6 +241,22 @@ def test_workers_map_the_members_of_scene_files(tmp_path):
         MappedNpz(tmp_path / "z.npz")
 
 
+def test_a_block_of_columns_written_in_place(tmp_path):
+    from collide.dask._files import write_columns
+
+    path = str(tmp_path / "x.npy")
+    expected = np.arange(30, dtype=np.float32).reshape(3, 10)
+    np.save(path, expected)
+    block = -np.arange(12, dtype=np.float32).reshape(3, 4)
+    write_columns(path, 5, block)
+    expected[:, 5:9] = block
+    assert np.load(path).tobytes() == expected.tobytes()
+    for first, bad in ((7, block), (0, block.astype(np.float64)), (0, block[:2])):
+        with pytest.raises(ValueError, match=r"x\.npy: a \(3, 10\) float32 array cannot take columns"):
+            write_columns(path, first, bad)
+    assert np.load(path).tobytes() == expected.tobytes()
+
+
 def test_partition_islands_is_a_balanced_deterministic_greedy():
     # Equal islands: consecutive runs of equal size.
     parts = cd.partition_islands(np.full(100, 5), 4)

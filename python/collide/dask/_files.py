@@ -15,6 +15,7 @@ with ``collide.load`` before any worker reads it.
 from __future__ import annotations
 
 import mmap
+import os
 import struct
 import zipfile
 
@@ -94,3 +95,26 @@ class MappedNpz:
             else:
                 np.take(c, rows, out=out[r])
         return out
+
+
+def write_columns(path, first, block):
+    """Writes ``block`` (k, c) into columns ``first`` .. ``first + c`` of the
+    (k, n) C-ordered array of the .npy file ``path``, one positioned write
+    per row (a row of the block is a contiguous run of the file). Writing
+    through ``os.pwrite`` copies into the page cache once; filling a mapping
+    of a new file would first fault in and zero every page it touches."""
+    block = np.ascontiguousarray(block)
+    with open(path, "r+b") as f:
+        version = np.lib.format.read_magic(f)
+        shape, fortran, dtype = (np.lib.format.read_array_header_1_0(f) if version == (1, 0) else
+                                 np.lib.format.read_array_header_2_0(f))
+        if fortran or len(shape) != 2 or dtype != block.dtype or block.shape[0] != shape[0] or (
+                first < 0 or first + block.shape[1] > shape[1]):
+            raise ValueError(f"{path}: a ({shape[0]}, {shape[1]}) {dtype} array cannot take columns {first} to "
+                             f"{first + block.shape[1]} of a {block.shape} {block.dtype} block")
+        data = f.tell()
+        for k in range(block.shape[0]):
+            row = memoryview(block[k]).cast("B")
+            written = 0
+            while written < len(row):  # pwrite may write less than asked
+                written += os.pwrite(f.fileno(), row[written:], data + (k * shape[1] + first) * dtype.itemsize + written)

@@ -17,13 +17,14 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import os
 import time
 
 import numpy as np
 
 import collide
 
-from ._files import MappedNpz
+from ._files import MappedNpz, write_columns
 
 def local_bodies(a, b):
     """The bodies contacts ``a``, ``b`` (uint32) name, ascending, and the
@@ -142,10 +143,10 @@ def solve_part_files(part, options):
     body named by several partitions is written by each with its input
     values: the same bytes). Where the partition's contacts, or its bodies,
     are a range of rows (independent pairs), they are read as views of the
-    mapping and J, or v and w, solved in place in the outputs: no copy but
-    the one of v and w into their output. Writing the same values again (a
-    task run again after its worker was lost) gives the same bytes. Returns
-    stats."""
+    mapping, and J, or v and w, written back by one positioned write per
+    row; scattered rows are written through a mapping of the output.
+    Writing the same values again (a task run again after its worker was
+    lost) gives the same bytes. Returns stats."""
     started = time.perf_counter()
     dtype = np.dtype(part["dtype"])
     rows = contact_rows(part)
@@ -159,24 +160,21 @@ def solve_part_files(part, options):
     # The inverses as collide.load computes them (the readers' own code).
     inv_mass, inv_inertia = collide._collide.inverses(bfile.stacked(("m",), ids, dtype)[0],
                                                       bfile.stacked(("Ix", "Iy", "Iz"), ids, dtype))
-    out = {k: np.load(part["outputs"][k], mmap_mode="r+") for k in ("J", "v", "w")}
-    vw = {}
-    for k in ("v", "w"):
-        names = tuple(k + axis for axis in "xyz")
-        if isinstance(ids, slice):
-            vw[k] = out[k][:, ids]
-            vw[k][...] = bfile.stacked(names, ids, dtype)
-        else:
-            vw[k] = bfile.stacked(names, ids, dtype)
+    vw = {k: bfile.stacked(tuple(k + axis for axis in "xyz"), ids, dtype) for k in ("v", "w")}
+    # The solve writes v and w: a view of the read-only input is copied.
+    vw = {k: x if x.flags.writeable else np.array(x) for k, x in vw.items()}
     bodies = collide.Bodies(inv_mass, inv_inertia, bfile.stacked(("qw", "qx", "qy", "qz"), ids, dtype),
                             bfile.stacked(("px", "py", "pz"), ids, dtype), vw["v"], vw["w"])
     read_seconds = time.perf_counter() - started
-    J, stats = _solve(bodies, contacts, options, out=out["J"][:, rows] if isinstance(rows, slice) else None)
-    if not isinstance(rows, slice):
-        out["J"][:, rows] = J
-    if not isinstance(ids, slice):
-        out["v"][:, ids] = vw["v"]
-        out["w"][:, ids] = vw["w"]
+    J, stats = _solve(bodies, contacts, options)
+    # Ranges of rows by positioned writes, scattered rows through a mapping.
+    out = {}
+    for k, x, where in (("J", J, rows), ("v", vw["v"], ids), ("w", vw["w"], ids)):
+        if isinstance(where, slice):
+            write_columns(part["outputs"][k], where.start, x)
+        else:
+            out[k] = np.load(part["outputs"][k], mmap_mode="r+")
+            out[k][:, where] = x
     if part["client_machine"] is None or part["client_machine"] != machine():
         # Another kernel reads the outputs: the writes go to the shared
         # storage before the task ends. On the client's own kernel they
@@ -184,6 +182,10 @@ def solve_part_files(part, options):
         # the disk would only cost time.
         for array in out.values():
             array.flush()
+        for k in ("J", "v", "w"):
+            if k not in out:
+                with open(part["outputs"][k], "rb") as f:
+                    os.fsync(f.fileno())
     return _part_stats(stats, len(contacts), len(bodies), started, read_seconds)
 
 
