@@ -32,7 +32,7 @@ struct PyIslands {
   Islands islands;
 
   /// A read-only (n,) uint32 view of `values`, kept alive by `self`.
-  static py::array view(const py::object& self, const std::vector<std::uint32_t>& values) {
+  static py::array view(const py::object& self, const Labels& values) {
     py::array a(py::dtype::of<std::uint32_t>(), {static_cast<py::ssize_t>(values.size())}, {sizeof(std::uint32_t)},
                 values.data(), self);
     set_read_only(a);

@@ -128,22 +128,22 @@ TEST(Islands, ChainAndPairInterleaved) {
   // Bodies 0-1-2 a chain, 3-4 a pair, 5 without contacts.
   const Islands s = islands_of(6, {{3, 4}, {0, 1}, {1, 2}, {4, 3}});
   EXPECT_EQ(s.count(), 2u);
-  EXPECT_EQ(s.contact_island, (std::vector<std::uint32_t>{0, 1, 1, 0}));
-  EXPECT_EQ(s.island_contacts, (std::vector<std::uint32_t>{2, 2}));
-  EXPECT_EQ(s.body_island, (std::vector<std::uint32_t>{1, 1, 1, 0, 0, kNone}));
+  EXPECT_EQ(s.contact_island, (Labels{0, 1, 1, 0}));
+  EXPECT_EQ(s.island_contacts, (Labels{2, 2}));
+  EXPECT_EQ(s.body_island, (Labels{1, 1, 1, 0, 0, kNone}));
   EXPECT_EQ(s.largest, 2u);
   EXPECT_EQ(s.largest_island, 0u);
 
   // Two chains that a late contact joins into one island.
   const Islands j = islands_of(6, {{0, 1}, {3, 4}, {1, 2}, {4, 5}, {2, 3}});
   EXPECT_EQ(j.count(), 1u);
-  EXPECT_EQ(j.contact_island, (std::vector<std::uint32_t>(5, 0)));
+  EXPECT_EQ(j.contact_island, (Labels(5, 0)));
   EXPECT_EQ(j.largest, 5u);
 
   const Islands none = islands_of(3, {});
   EXPECT_EQ(none.count(), 0u);
   EXPECT_EQ(none.largest, 0u);
-  EXPECT_EQ(none.body_island, (std::vector<std::uint32_t>(3, kNone)));
+  EXPECT_EQ(none.body_island, (Labels(3, kNone)));
 }
 
 TEST(Islands, ImmovableBodiesJoinNothing) {
@@ -151,9 +151,9 @@ TEST(Islands, ImmovableBodiesJoinNothing) {
   const std::vector<bool> immovable = {false, false, false, false, true, true};
   const Islands s = islands_of(6, {{0, 4}, {1, 4}, {4, 2}, {3, 4}, {0, 4}, {4, 5}, {5, 3}}, immovable);
   // Contacts 0 and 4 share body 0; 5 is between the two immovable bodies.
-  EXPECT_EQ(s.contact_island, (std::vector<std::uint32_t>{0, 1, 2, 3, 0, 4, 3}));
-  EXPECT_EQ(s.island_contacts, (std::vector<std::uint32_t>{2, 1, 1, 2, 1}));
-  EXPECT_EQ(s.body_island, (std::vector<std::uint32_t>{0, 1, 2, 3, kNone, kNone}));
+  EXPECT_EQ(s.contact_island, (Labels{0, 1, 2, 3, 0, 4, 3}));
+  EXPECT_EQ(s.island_contacts, (Labels{2, 1, 1, 2, 1}));
+  EXPECT_EQ(s.body_island, (Labels{0, 1, 2, 3, kNone, kNone}));
   EXPECT_EQ(s.largest, 2u);
   EXPECT_EQ(s.largest_island, 0u);
   // A million-contact ground would be a million islands: here, 1000.

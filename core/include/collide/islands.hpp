@@ -42,6 +42,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "collide/bodies.hpp"
@@ -50,17 +53,45 @@
 
 namespace collide {
 
+/// The allocator of the label arrays of Islands: std::allocator's, except
+/// that resize() leaves the new values uninitialised (islands() writes every
+/// one in its parallel passes; a std::vector would first zero them on one
+/// thread, a third of the whole pass at 16M contacts) and that arrays of
+/// 2 MiB or more are asked for 2 MiB pages where the system has them.
+struct LabelAllocator {
+  using value_type = std::uint32_t;
+  template <class U>
+  struct rebind {  // for std::vector<std::uint32_t> only
+    static_assert(std::is_same_v<U, std::uint32_t>, "LabelAllocator allocates labels");
+    using other = LabelAllocator;
+  };
+
+  [[nodiscard]] std::uint32_t* allocate(std::size_t n);
+  void deallocate(std::uint32_t* p, std::size_t n) noexcept;
+  /// Value-initialisation (resize(n)) leaves the value as it is.
+  void construct(std::uint32_t* p) noexcept { ::new (static_cast<void*>(p)) std::uint32_t; }
+  template <class... Args>
+  void construct(std::uint32_t* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) std::uint32_t(std::forward<Args>(args)...);
+  }
+  friend bool operator==(const LabelAllocator&, const LabelAllocator&) noexcept { return true; }
+  friend bool operator!=(const LabelAllocator&, const LabelAllocator&) noexcept { return false; }
+};
+
+/// One label (or count) per contact, body or island.
+using Labels = std::vector<std::uint32_t, LabelAllocator>;
+
 /// The islands of a contact set (islands()).
 struct Islands {
   /// The label of no island: an immovable body, or a body without contacts.
   static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   /// The island of each contact, in input order: 0 .. count() - 1, numbered
   /// in the order of the islands' first contacts.
-  std::vector<std::uint32_t> contact_island;
+  Labels contact_island;
   /// The island of each body, or kNone (immovable, or without contacts).
-  std::vector<std::uint32_t> body_island;
+  Labels body_island;
   /// The number of contacts of each island.
-  std::vector<std::uint32_t> island_contacts;
+  Labels island_contacts;
   /// Contacts of the largest island (0 without contacts).
   std::size_t largest = 0;
   /// The label of the largest island (the first of that size); 0 without contacts.
