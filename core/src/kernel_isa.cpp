@@ -53,7 +53,7 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
 
 /// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
 /// so that the index gather and the paired load share one field list.
-template <class M, class V, class View, class F>
+template <class M, class V, bool kVelocities = true, class View, class F>
 COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
   f(view.inv_mass, a.inv_mass, b.inv_mass);
   if constexpr (std::is_same_v<M, RigidModel>) {
@@ -74,13 +74,15 @@ COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyL
     f(view.p.y, a.p.y, b.p.y);
     f(view.p.z, a.p.z, b.p.z);
   }
-  f(view.v.x, a.v.x, b.v.x);
-  f(view.v.y, a.v.y, b.v.y);
-  f(view.v.z, a.v.z, b.v.z);
-  if constexpr (kRotates<M>) {
-    f(view.w.x, a.w.x, b.w.x);
-    f(view.w.y, a.w.y, b.w.y);
-    f(view.w.z, a.w.z, b.w.z);
+  if constexpr (kVelocities) {  // not for the geometry of a run (run_geometry): its walk reads them
+    f(view.v.x, a.v.x, b.v.x);
+    f(view.v.y, a.v.y, b.v.y);
+    f(view.v.z, a.v.z, b.v.z);
+    if constexpr (kRotates<M>) {
+      f(view.w.x, a.w.x, b.w.x);
+      f(view.w.y, a.w.y, b.w.y);
+      f(view.w.z, a.w.z, b.w.z);
+    }
   }
 }
 
@@ -119,12 +121,13 @@ template <class Record>
 inline constexpr bool kSoaLayout<PackedView<Record>> = false;
 
 /// The bodies ia[0..W) and ib[0..W) into lanes by index: gathers from the
-/// SoA arrays, or row loads and transposes from packed records.
-template <class M, class V, class T, class View>
+/// SoA arrays, or row loads and transposes from packed records (whose rows
+/// hold the velocities whatever kVelocities says).
+template <class M, class V, class T, bool kVelocities = true, class View>
 COLLIDE_LANE_INLINE void gather_bodies(const View& bodies, const BodyIndex* ia, const BodyIndex* ib, BodyLanes<M, V>& a,
                                        BodyLanes<M, V>& b) {
   if constexpr (kSoaLayout<View>) {
-    read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+    read_bodies<M, V, kVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
       la = gather<V>(field, ia);
       lb = gather<V>(field, ib);
     });
@@ -286,41 +289,42 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
   return i;
 }
 
+/// Calls f(view, model) with the job's body view and model.
+template <class T, class F>
+decltype(auto) with_view(const KernelJob<T>& job, const F& f) {
+  if (job.packed) {
+    switch (job.model) {
+      case Model::particle:
+        return f(job.packed_particle, ParticleModel{});
+      case Model::sphere:
+        return f(job.packed_sphere, SphereModel{});
+      case Model::rigid:
+        break;
+    }
+    return f(job.packed_rigid, RigidModel{});
+  }
+  switch (job.model) {
+    case Model::particle:
+      return f(job.particle, ParticleModel{});
+    case Model::sphere:
+      return f(job.sphere, SphereModel{});
+    case Model::rigid:
+      break;
+  }
+  return f(job.rigid, RigidModel{});
+}
+
 /// The job's model and friction, as template arguments.
 template <class V, class T, class Mode>
 std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
   // `view` is a SoA view or a PackedView: solve_group tells them apart.
-  const auto run = [&](const auto& view, auto model, auto friction) {
+  return with_view(job, [&](const auto& view, auto model) {
     using M = decltype(model);
-    constexpr bool kFriction = decltype(friction)::value;
-    return solve_groups<M, V, kFriction, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin, end);
-  };
-  const std::true_type with_friction;
-  const std::false_type without;
-  if (job.packed) {
-    switch (job.model) {
-      case Model::particle:
-        return job.friction ? run(job.packed_particle, ParticleModel{}, with_friction)
-                            : run(job.packed_particle, ParticleModel{}, without);
-      case Model::sphere:
-        return job.friction ? run(job.packed_sphere, SphereModel{}, with_friction)
-                            : run(job.packed_sphere, SphereModel{}, without);
-      case Model::rigid:
-        break;
-    }
-    return job.friction ? run(job.packed_rigid, RigidModel{}, with_friction)
-                        : run(job.packed_rigid, RigidModel{}, without);
-  }
-  switch (job.model) {
-    case Model::particle:
-      return job.friction ? run(job.particle, ParticleModel{}, with_friction)
-                          : run(job.particle, ParticleModel{}, without);
-    case Model::sphere:
-      return job.friction ? run(job.sphere, SphereModel{}, with_friction) : run(job.sphere, SphereModel{}, without);
-    case Model::rigid:
-      break;
-  }
-  return job.friction ? run(job.rigid, RigidModel{}, with_friction) : run(job.rigid, RigidModel{}, without);
+    return job.friction
+               ? solve_groups<M, V, true, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin, end)
+               : solve_groups<M, V, false, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin,
+                                                    end);
+  });
 }
 
 /// ... and its accuracy mode.
@@ -329,24 +333,6 @@ std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size
   return job.accurate ? solve_job_groups_in<V, T, AccurateMode>(job, contiguous, begin, end)
                       : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
 }
-
-/// Contacts per piece of a sequential run (solve_run): the geometry of a
-/// piece, 64 bytes a contact in float, stays in L1 between the two passes.
-inline constexpr std::size_t kRunPiece = 128;
-
-/// The geometry of a piece (ContactGeometry) and the inverse masses, one
-/// array per value: the first pass stores lanes, the second reads one value.
-template <class T>
-struct RunPiece {
-  alignas(64) T ra[3][kRunPiece];
-  alignas(64) T rb[3][kRunPiece];
-  alignas(64) T response_a[3][kRunPiece];
-  alignas(64) T response_b[3][kRunPiece];
-  alignas(64) T k_a[kRunPiece];
-  alignas(64) T k_b[kRunPiece];
-  alignas(64) T inv_mass_a[kRunPiece];
-  alignas(64) T inv_mass_b[kRunPiece];
-};
 
 template <class V>
 COLLIDE_LANE_INLINE void store3(const Vec3<V>& v, typename V::value_type (*to)[kRunPiece], std::size_t at) {
@@ -360,9 +346,11 @@ COLLIDE_LANE_INLINE Vec3<S> load3(const typename S::value_type (*from)[kRunPiece
 }
 
 /// First pass: the geometry of the W contacts order[at], ... of a piece, in
-/// lanes, from the bodies' positions, orientations and inverse masses (their
-/// velocities are read with the record and ignored: the second pass reads
-/// them as the contacts before have left them).
+/// lanes, from the bodies' positions, orientations and inverse masses. Their
+/// velocities are not read from SoA arrays (another thread may be walking
+/// the contacts before this piece, run_pipeline.hpp); a packed record's come
+/// with its rows and are ignored: the walk reads them as the contacts
+/// before have left them.
 template <class M, class V, class T, class View>
 COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* index,
                                       RunPiece<T>& piece, std::size_t at) {
@@ -376,7 +364,7 @@ COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& 
   }
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
-  gather_bodies<M, V, T>(bodies, ia, ib, a, b);
+  gather_bodies<M, V, T, false>(bodies, ia, ib, a, b);
   ContactLanes<V> c;
   if constexpr (kRotates<M>)
     c.c = {gather<V>(contacts.c.x, index), gather<V>(contacts.c.y, index), gather<V>(contacts.c.z, index)};
@@ -425,57 +413,91 @@ COLLIDE_LANE_INLINE void write_velocities(const View& view, BodyIndex i, const B
   if constexpr (kRotates<M>) *w[0] = body.w.x[0], *w[1] = body.w.y[0], *w[2] = body.w.z[0];
 }
 
+/// The geometry of the contacts order[first, first + count) of a run (count
+/// <= kRunPiece) into `piece`: what does not depend on the velocities (the
+/// offsets, the lever arms and their K terms: most of the arithmetic, and all
+/// of the wide lever arms' work), formed in lanes of V, W contacts at a time,
+/// the rest one by one. No contact of the run changes a position or an
+/// orientation, so it may be formed before the contacts ahead are walked.
+template <class M, class V, class T, class View>
+void piece_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* order,
+                    std::size_t count, RunPiece<T>& piece) {
+  using S = ScalarLanes<T>;
+  constexpr std::size_t W = V::size();
+  assert(count <= kRunPiece);
+  std::size_t at = 0;
+  for (; at + W <= count; at += W) run_geometry<M, V, T>(bodies, contacts, order + at, piece, at);
+  for (; at < count; ++at) run_geometry<M, S, T>(bodies, contacts, order + at, piece, at);
+}
+
+/// The walk of the contacts order[0, count) of a piece, in order, in one
+/// lane: each reads the velocities the contacts before it left and applies
+/// its impulse. Every value is formed by the operations evaluate_law performs
+/// on it (contact_geometry, normal_impulse, apply_impulse), so the bits are
+/// those of the one-lane kernel.
+template <class M, class T, class View>
+void piece_walk(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                const std::uint32_t* order, std::size_t count, const RunPiece<T>& piece) {
+  using S = ScalarLanes<T>;
+  for (std::size_t j = 0; j < count; ++j) {
+    const std::uint32_t k = order[j];
+    const BodyIndex ia = contacts.a[k];
+    const BodyIndex ib = contacts.b[k];
+    BodyLanes<M, S> a;
+    BodyLanes<M, S> b;
+    a.inv_mass = S(piece.inv_mass_a[j]);
+    b.inv_mass = S(piece.inv_mass_b[j]);
+    read_velocities<M, S>(bodies, ia, a);
+    read_velocities<M, S>(bodies, ib, b);
+    ContactLanes<S> c;
+    c.n = {S(contacts.n.x[k]), S(contacts.n.y[k]), S(contacts.n.z[k])};
+    c.e = S(contacts.e != nullptr ? contacts.e[k] : contacts.uniform_e);
+    ContactGeometry<S> g{};
+    if constexpr (kRotates<M>) {
+      g.ra = load3<S>(piece.ra, j);
+      g.rb = load3<S>(piece.rb, j);
+      g.arm_a = {load3<S>(piece.response_a, j), S(piece.k_a[j])};
+      g.arm_b = {load3<S>(piece.response_b, j), S(piece.k_b[j])};
+    }
+    const NormalImpulse<S> normal = normal_impulse<M, S, FastMode>(a, b, c, g);
+    apply_impulse(a, b, c.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
+    if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
+    if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
+    const Vec3<S> jv = c.n * normal.jn;
+    impulses.j.x[k] = jv.x[0];
+    impulses.j.y[k] = jv.y[0];
+    impulses.j.z[k] = jv.z[0];
+  }
+}
+
 /// A run of contacts order[begin, end) applied one after another (a chain, a
-/// stack: batches of a contact or a few), frictionless, in the fast mode.
-/// What does not depend on the velocities (the offsets, the lever arms and
-/// their K terms: most of the arithmetic, and all of the wide lever arms'
-/// work) is formed for a piece of kRunPiece contacts in lanes of V, whose
-/// bodies' positions and orientations no contact of the run changes; then the
-/// contacts are walked in order in one lane, each reading the velocities the
-/// contacts before it left. Every value is formed by the operations
-/// evaluate_law performs on it (contact_geometry, normal_impulse,
-/// apply_impulse), so the bits are those of the one-lane kernel.
+/// stack: batches of a contact or a few), frictionless, in the fast mode, on
+/// this thread: piece after piece, its geometry and then its walk.
 template <class M, class V, class T, class View>
 void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
                       const std::uint32_t* order, std::size_t begin, std::size_t end) {
-  using S = ScalarLanes<T>;
-  constexpr std::size_t W = V::size();
   RunPiece<T> piece;
   for (std::size_t first = begin; first < end; first += kRunPiece) {
     const std::size_t count = std::min(kRunPiece, end - first);
-    std::size_t at = 0;
-    for (; at + W <= count; at += W) run_geometry<M, V, T>(bodies, contacts, order + first + at, piece, at);
-    for (; at < count; ++at) run_geometry<M, S, T>(bodies, contacts, order + first + at, piece, at);
-    for (std::size_t j = 0; j < count; ++j) {
-      const std::uint32_t k = order[first + j];
-      const BodyIndex ia = contacts.a[k];
-      const BodyIndex ib = contacts.b[k];
-      BodyLanes<M, S> a;
-      BodyLanes<M, S> b;
-      a.inv_mass = S(piece.inv_mass_a[j]);
-      b.inv_mass = S(piece.inv_mass_b[j]);
-      read_velocities<M, S>(bodies, ia, a);
-      read_velocities<M, S>(bodies, ib, b);
-      ContactLanes<S> c;
-      c.n = {S(contacts.n.x[k]), S(contacts.n.y[k]), S(contacts.n.z[k])};
-      c.e = S(contacts.e != nullptr ? contacts.e[k] : contacts.uniform_e);
-      ContactGeometry<S> g{};
-      if constexpr (kRotates<M>) {
-        g.ra = load3<S>(piece.ra, j);
-        g.rb = load3<S>(piece.rb, j);
-        g.arm_a = {load3<S>(piece.response_a, j), S(piece.k_a[j])};
-        g.arm_b = {load3<S>(piece.response_b, j), S(piece.k_b[j])};
-      }
-      const NormalImpulse<S> normal = normal_impulse<M, S, FastMode>(a, b, c, g);
-      apply_impulse(a, b, c.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
-      if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
-      if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
-      const Vec3<S> jv = c.n * normal.jn;
-      impulses.j.x[k] = jv.x[0];
-      impulses.j.y[k] = jv.y[0];
-      impulses.j.z[k] = jv.z[0];
-    }
+    piece_geometry<M, V, T>(bodies, contacts, order + first, count, piece);
+    piece_walk<M, T>(bodies, contacts, impulses, order + first, count, piece);
   }
+}
+
+/// RunGeometryKernel and RunWalkKernel of kernel_table.hpp.
+template <class T>
+void run_piece_geometry(const KernelJob<T>& job, std::size_t first, std::size_t count, RunPiece<T>& piece) {
+  assert(!job.accurate && !job.friction);
+  with_view(job, [&](const auto& view, auto model) {
+    piece_geometry<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.order + first, count, piece);
+  });
+}
+template <class T>
+void run_piece_walk(const KernelJob<T>& job, std::size_t first, std::size_t count, const RunPiece<T>& piece) {
+  assert(!job.accurate && !job.friction);
+  with_view(job, [&](const auto& view, auto model) {
+    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.order + first, count, piece);
+  });
 }
 
 /// A run of the job (solve_run_pieces); the accurate mode and friction take
@@ -486,29 +508,9 @@ void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
     solve_range_scalar<T>(job, false, begin, end);
     return;
   }
-  using V = SimdLanes<T>;
-  const auto run = [&](const auto& view, auto model) {
-    solve_run_pieces<decltype(model), V, T>(view, job.contacts, job.impulses, job.order, begin, end);
-  };
-  if (job.packed) {
-    switch (job.model) {
-      case Model::particle:
-        return run(job.packed_particle, ParticleModel{});
-      case Model::sphere:
-        return run(job.packed_sphere, SphereModel{});
-      case Model::rigid:
-        return run(job.packed_rigid, RigidModel{});
-    }
-  }
-  switch (job.model) {
-    case Model::particle:
-      return run(job.particle, ParticleModel{});
-    case Model::sphere:
-      return run(job.sphere, SphereModel{});
-    case Model::rigid:
-      break;
-  }
-  run(job.rigid, RigidModel{});
+  with_view(job, [&](const auto& view, auto model) {
+    solve_run_pieces<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.impulses, job.order, begin, end);
+  });
 }
 
 }  // namespace
@@ -546,7 +548,11 @@ const KernelTable& COLLIDE_CONCAT(kernel_table_, COLLIDE_KERNEL_NS)() {
                                  &solve_range_simd<float>,
                                  &solve_range_simd<double>,
                                  &solve_run<float>,
-                                 &solve_run<double>};
+                                 &solve_run<double>,
+                                 &run_piece_geometry<float>,
+                                 &run_piece_geometry<double>,
+                                 &run_piece_walk<float>,
+                                 &run_piece_walk<double>};
   return table;
 }
 

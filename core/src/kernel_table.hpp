@@ -61,6 +61,38 @@ using RangeKernel = void (*)(const KernelJob<T>& job, bool contiguous, std::size
 template <class T>
 using RunKernel = void (*)(const KernelJob<T>& job, std::size_t begin, std::size_t end);
 
+/// Contacts per piece of a run (solve_run in kernel_isa.cpp): the geometry
+/// of a piece, 64 bytes a contact in float, stays in L1 between the pass that
+/// forms it and the walk that reads it.
+inline constexpr std::size_t kRunPiece = 128;
+
+/// The geometry of a piece of a run (the offsets, lever arms and K terms of
+/// contact_kernel.hpp's ContactGeometry) and the inverse masses, one array
+/// per value: the geometry pass stores lanes, the walk reads one value.
+template <class T>
+struct RunPiece {
+  alignas(64) T ra[3][kRunPiece];
+  alignas(64) T rb[3][kRunPiece];
+  alignas(64) T response_a[3][kRunPiece];
+  alignas(64) T response_b[3][kRunPiece];
+  alignas(64) T k_a[kRunPiece];
+  alignas(64) T k_b[kRunPiece];
+  alignas(64) T inv_mass_a[kRunPiece];
+  alignas(64) T inv_mass_b[kRunPiece];
+};
+
+/// The two halves of a run, for a driver that overlaps them on two threads
+/// (run_pipeline.hpp): the geometry of order[first, first + count) (count <=
+/// kRunPiece) into `piece`, which reads positions, orientations and inverse
+/// masses but no velocity (SoA layouts only: a packed record holds both);
+/// and the walk of those contacts over their piece, in order, reading and
+/// writing velocities. Fast mode, frictionless, as RunKernel.
+template <class T>
+using RunGeometryKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count, RunPiece<T>& piece);
+template <class T>
+using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                               const RunPiece<T>& piece);
+
 /// The SIMD kernels of one instruction set.
 struct KernelTable {
   Isa isa = Isa::sse2;
@@ -70,6 +102,10 @@ struct KernelTable {
   RangeKernel<double> simd_double = nullptr;
   RunKernel<float> run_float = nullptr;
   RunKernel<double> run_double = nullptr;
+  RunGeometryKernel<float> run_geometry_float = nullptr;
+  RunGeometryKernel<double> run_geometry_double = nullptr;
+  RunWalkKernel<float> run_walk_float = nullptr;
+  RunWalkKernel<double> run_walk_double = nullptr;
 };
 
 /// The table of a concrete ISA (not automatic) that this build has.

@@ -40,6 +40,7 @@
 #include "collide/validate.hpp"
 #include "isa_calibration.hpp"
 #include "kernel_table.hpp"
+#include "run_pipeline.hpp"
 #include "scratch_records.hpp"
 
 namespace collide {
@@ -210,6 +211,24 @@ RunKernel<T> run_kernel(const KernelTable& table) {
 }
 
 template <class T>
+RunGeometryKernel<T> run_geometry_kernel(const KernelTable& table) {
+  if constexpr (std::is_same_v<T, float>) {
+    return table.run_geometry_float;
+  } else {
+    return table.run_geometry_double;
+  }
+}
+
+template <class T>
+RunWalkKernel<T> run_walk_kernel(const KernelTable& table) {
+  if constexpr (std::is_same_v<T, float>) {
+    return table.run_walk_float;
+  } else {
+    return table.run_walk_double;
+  }
+}
+
+template <class T>
 std::size_t simd_lanes(const KernelTable& table) {
   return std::is_same_v<T, float> ? table.lanes_float : table.lanes_double;
 }
@@ -246,7 +265,11 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
         // solve_run); only the call and dispatch per batch are saved, and on
         // the SIMD path the lever arms are formed in lanes.
         while (k + 1 < batches && one_lane(schedule.batch_begin(k + 2) - end)) end = schedule.batch_begin(++k + 1);
-        if (simd) {
+        if (simd && !one_thread && !job.packed && !job.accurate && !job.friction &&
+            end - begin >= kPipelinedRunPieces * kRunPiece) {
+          // The pieces' geometry on a second thread (run_pipeline.hpp).
+          run_pipelined<T>(run_geometry_kernel<T>(table), run_walk_kernel<T>(table), job, begin, end);
+        } else if (simd) {
           run_kernel<T>(table)(job, begin, end);
         } else {
           solve_range_scalar<T>(job, false, begin, end);
