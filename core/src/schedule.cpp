@@ -33,7 +33,9 @@
 //    chunk counts its levels, a prefix over (level, chunk) gives every chunk
 //    its first slot in every batch, and each chunk scatters its contacts in
 //    input order. The result is the sequential stable sort, whatever the
-//    number of chunks; a scene of one level (the pairs scene) is the identity.
+//    number of chunks; a scene of one level (the pairs scene), or one whose
+//    contacts come grouped by level already (a chain in chain order), is
+//    the identity and is not sorted.
 //    Passes 1 and 3 of a one-level scene stream a few bytes per contact and
 //    take a fraction of a millisecond per million: they stay on the calling
 //    thread, since waking workers for them cost more wall time than it saved
@@ -397,6 +399,29 @@ void Schedule::sort_by_level(const Level* level, std::uint32_t levels, std::size
     // One batch: every contact in input order.
     std::iota(order, order + n, std::uint32_t{0});
     batch_begin_[1] = static_cast<std::uint32_t>(n);
+  } else if (std::is_sorted(level, level + n)) {
+    // Already grouped by level (a chain in chain order, contacts handed over
+    // in solve order): the stable sort is the identity, and each batch
+    // starts where the levels step up. Levels leave no gap (a contact of
+    // level L > 0 follows one of level L - 1 on a body), but a step is
+    // filled over any it spans. Unsorted levels stop the test at their
+    // first descent.
+    // Every batch is consecutive contacts: pass 4 is done here too.
+    std::iota(order, order + n, std::uint32_t{0});
+    std::size_t largest = 0;
+    std::size_t start = 0;
+    for (std::size_t k = 1; k < n; ++k) {
+      if (level[k] == level[k - 1]) continue;
+      largest = std::max(largest, k - start);
+      start = k;
+      for (std::size_t L = std::size_t{level[k - 1]} + 1; L <= std::size_t{level[k]}; ++L) {
+        batch_begin_[L] = static_cast<std::uint32_t>(k);
+      }
+    }
+    batch_begin_[levels] = static_cast<std::uint32_t>(n);
+    largest_batch_ = std::max(largest, n - start);
+    contiguous_.assign(levels, 1);
+    return;
   } else if (chunks == 1) {
     // batch_begin_[L + 1] counts level L, the prefix sum turns counts into
     // starts, and filling advances batch_begin_[L] to the end of level L;

@@ -338,6 +338,34 @@ Topology all_shared_topology(std::size_t n) {
   return t;
 }
 
+/// A scene whose contacts double from level to level, handed over grouped by
+/// level: level L joins each body i < 2^L to a new body 2^L + i, so the
+/// largest batch is the last.
+Topology fan_topology(std::size_t levels) {
+  const std::size_t bodies = std::size_t{1} << levels;
+  Topology t{"fan of " + std::to_string(levels) + " levels", {}, {}, std::vector<float>(bodies, 1.0f)};
+  for (std::size_t L = 0; L + 1 <= levels; ++L) {
+    for (std::size_t i = 0; i < (std::size_t{1} << L); ++i) {
+      t.a.push_back(static_cast<BodyIndex>(i));
+      t.b.push_back(static_cast<BodyIndex>((std::size_t{1} << L) + i));
+    }
+  }
+  return t;
+}
+
+/// `t` with its contacts in the order of its reference schedule: grouped by
+/// level, as a caller who keeps them in solve order hands them over.
+Topology grouped_topology(const Topology& t) {
+  Topology g{t.name + ", grouped by level", {}, {}, t.inv_mass};
+  for (const std::vector<std::uint32_t>& batch : ReferenceSchedule(t).batches) {
+    for (const std::uint32_t k : batch) {
+      g.a.push_back(t.a[k]);
+      g.b.push_back(t.b[k]);
+    }
+  }
+  return g;
+}
+
 // Sizes: scenes of 65536 contacts and more are sorted in chunks
 // on 2 threads or more (32768 per chunk at least, schedule.cpp), the smaller
 // ones run on one; 16 is the prefetch distance.
@@ -356,6 +384,11 @@ TEST(Schedule, EqualsPlainLevelRuleOnEveryShapeAndThreadCount) {
       random_topology(15, 8, 0.0, 8),           // shorter than it
       random_topology(1, 2, 0.0, 9),
       random_topology(0, 2, 0.0, 10),
+      // Contacts already grouped by level: the schedule is the identity.
+      fan_topology(12),
+      grouped_topology(debris_topology(3000, 3)),
+      grouped_topology(random_topology(40000, 400, 0.1, 11)),
+      grouped_topology(all_shared_topology(5000)),
   };
   for (const Topology& t : scenes) {
     for (const int threads : {1, 2, 3, 8, 0}) {
