@@ -366,8 +366,9 @@ COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& 
   BodyLanes<M, V> b;
   gather_bodies<M, V, T, false>(bodies, ia, ib, a, b);
   ContactLanes<V> c;
-  if constexpr (kRotates<M>)
+  if constexpr (kRotates<M>) {
     c.c = {gather<V>(contacts.c.x, index), gather<V>(contacts.c.y, index), gather<V>(contacts.c.z, index)};
+  }
   c.n = {gather<V>(contacts.n.x, index), gather<V>(contacts.n.y, index), gather<V>(contacts.n.z, index)};
   const ContactGeometry<V> g = contact_geometry(a, b, c);
   store(a.inv_mass, piece.inv_mass_a + at);
@@ -420,8 +421,8 @@ COLLIDE_LANE_INLINE void write_velocities(const View& view, BodyIndex i, const B
 /// the rest one by one. No contact of the run changes a position or an
 /// orientation, so it may be formed before the contacts ahead are walked.
 template <class M, class V, class T, class View>
-void piece_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* order,
-                    std::size_t count, RunPiece<T>& piece) {
+void piece_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* order, std::size_t count,
+                    RunPiece<T>& piece) {
   using S = ScalarLanes<T>;
   constexpr std::size_t W = V::size();
   assert(count <= kRunPiece);

@@ -90,8 +90,7 @@ struct RunPiece {
 template <class T>
 using RunGeometryKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count, RunPiece<T>& piece);
 template <class T>
-using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count,
-                               const RunPiece<T>& piece);
+using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count, const RunPiece<T>& piece);
 
 /// The SIMD kernels of one instruction set.
 struct KernelTable {

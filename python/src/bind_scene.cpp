@@ -222,8 +222,8 @@ std::string choose_model_py(const Bodies& bodies, const Contacts& contacts, bool
     using T = decltype(tag);
     if (check) {
       validate_or_throw<T>(bodies, contacts);
-    } else if (const Validation v = validate_indices(contacts.view<T>().a, contacts.view<T>().b, contacts.count,
-                                                     bodies.count);
+    } else if (const Validation v =
+                   validate_indices(contacts.view<T>().a, contacts.view<T>().b, contacts.count, bodies.count);
                !v) {
       throw py::value_error(v.message);
     }

@@ -335,10 +335,13 @@ void register_solve(py::module_& m) {
 
   py::class_<ThreadLimit>(m, "ThreadLimit")
       .def(py::init<int>(), py::arg("threads"))
-      .def("__enter__", [](ThreadLimit& t) -> ThreadLimit& {
-             t.enter();
-             return t;
-           }, py::return_value_policy::reference)
+      .def(
+          "__enter__",
+          [](ThreadLimit& t) -> ThreadLimit& {
+            t.enter();
+            return t;
+          },
+          py::return_value_policy::reference)
       .def("__exit__", [](ThreadLimit& t, const py::args&) { t.exit(); });
 
   py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
