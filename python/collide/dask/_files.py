@@ -115,6 +115,7 @@ def write_columns(path, first, block):
         data = f.tell()
         for k in range(block.shape[0]):
             row = memoryview(block[k]).cast("B")
+            at = data + (k * shape[1] + first) * dtype.itemsize
             written = 0
             while written < len(row):  # pwrite may write less than asked
-                written += os.pwrite(f.fileno(), row[written:], data + (k * shape[1] + first) * dtype.itemsize + written)
+                written += os.pwrite(f.fileno(), row[written:], at + written)
