@@ -192,45 +192,19 @@ const KernelTable& kernel_table(Isa isa) {
 
 namespace {
 
-template <class T>
-RangeKernel<T> simd_kernel(const KernelTable& table) {
+/// The entry of a KernelTable for precision T: its float one or its double one.
+template <class T, class F, class D>
+auto of_precision(const F& for_float, const D& for_double) {
   if constexpr (std::is_same_v<T, float>) {
-    return table.simd_float;
+    return for_float;
   } else {
-    return table.simd_double;
-  }
-}
-
-template <class T>
-RunKernel<T> run_kernel(const KernelTable& table) {
-  if constexpr (std::is_same_v<T, float>) {
-    return table.run_float;
-  } else {
-    return table.run_double;
-  }
-}
-
-template <class T>
-RunGeometryKernel<T> run_geometry_kernel(const KernelTable& table) {
-  if constexpr (std::is_same_v<T, float>) {
-    return table.run_geometry_float;
-  } else {
-    return table.run_geometry_double;
-  }
-}
-
-template <class T>
-RunWalkKernel<T> run_walk_kernel(const KernelTable& table) {
-  if constexpr (std::is_same_v<T, float>) {
-    return table.run_walk_float;
-  } else {
-    return table.run_walk_double;
+    return for_double;
   }
 }
 
 template <class T>
 std::size_t simd_lanes(const KernelTable& table) {
-  return std::is_same_v<T, float> ? table.lanes_float : table.lanes_double;
+  return of_precision<T>(table.lanes_float, table.lanes_double);
 }
 
 /// Walks the batches of the schedule; blocks of a large batch run in parallel.
@@ -242,7 +216,7 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
   const bool simd = opt.path == Path::simd;
   const std::size_t width = simd ? simd_lanes<T>(table) : 1;
   const std::size_t block = std::max<std::size_t>(width, (opt.block + width - 1) / width * width);
-  const RangeKernel<T> kernel = simd ? simd_kernel<T>(table) : &solve_range_scalar<T>;
+  const RangeKernel<T> kernel = simd ? of_precision<T>(table.simd_float, table.simd_double) : &solve_range_scalar<T>;
 
   const std::size_t batches = schedule.batch_count();
 
@@ -268,9 +242,10 @@ SolveStats run_schedule(const SolverOptions& opt, const IsaPick& pick, tbb::task
         if (simd && !one_thread && !job.packed && !job.accurate && !job.friction &&
             end - begin >= kPipelinedRunPieces * kRunPiece) {
           // The pieces' geometry on a second thread (run_pipeline.hpp).
-          run_pipelined<T>(run_geometry_kernel<T>(table), run_walk_kernel<T>(table), job, begin, end);
+          run_pipelined<T>(of_precision<T>(table.run_geometry_float, table.run_geometry_double),
+                           of_precision<T>(table.run_walk_float, table.run_walk_double), job, begin, end);
         } else if (simd) {
-          run_kernel<T>(table)(job, begin, end);
+          of_precision<T>(table.run_float, table.run_double)(job, begin, end);
         } else {
           solve_range_scalar<T>(job, false, begin, end);
         }

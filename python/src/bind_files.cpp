@@ -117,14 +117,7 @@ py::tuple load_t(const std::string& bodies_path, const std::string& contacts_pat
   const std::size_t n = bc.count;
   // The inverses the solver takes are computed; q and p stay in the file;
   // v and w are copied, since a solve writes them.
-  py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
-  py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
-  {
-    T* const im = data<T>(inv_mass);
-    const Vec3Array<T> ii = vec3<T>(inv_inertia);
-    py::gil_scoped_release release;
-    inverses_of(bc, im, ii);
-  }
+  const auto [inv_mass, inv_inertia] = inverse_arrays(bc, d);
   const auto cols = [&bc](std::size_t first, std::size_t count) {
     return std::vector<const T*>(bc.column.begin() + first, bc.column.begin() + first + count);
   };

@@ -160,20 +160,16 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
     columns.column = {data<T>(m),   row<T>(I, 0), row<T>(I, 1), row<T>(I, 2), row<T>(q, 0), row<T>(q, 1),
                       row<T>(q, 2), row<T>(q, 3), row<T>(p, 0), row<T>(p, 1), row<T>(p, 2), row<T>(v, 0),
                       row<T>(v, 1), row<T>(v, 2), row<T>(w, 0), row<T>(w, 1), row<T>(w, 2)};
-    py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
-    py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
     std::optional<RowDefect> defect;
     {
-      T* const im = data<T>(inv_mass);
-      const Vec3Array<T> ii = vec3<T>(inv_inertia);
       py::gil_scoped_release release;
       defect = first_body_defect(columns);
-      if (!defect) inverses_of(columns, im, ii);
     }
     if (defect) {
       throw py::value_error(owner + ": body " + std::to_string(defect->row) + ", column '" +
                             std::string(defect->defect.column) + "': " + defect->defect.reason);
     }
+    const auto [inv_mass, inv_inertia] = inverse_arrays(columns, d);
     const auto copy = [&](std::size_t first, std::size_t rows) {
       return copy_rows<T>(dt, columns.column.data() + first, rows, n);
     };
@@ -200,14 +196,7 @@ py::tuple inverses_py(const py::object& m_in, const py::object& inertia_in) {
     columns.count = n;
     columns.column[0] = data<T>(m);
     for (py::ssize_t k = 0; k < 3; ++k) columns.column[static_cast<std::size_t>(1 + k)] = row<T>(I, k);
-    py::array inv_mass = new_array(d, {static_cast<py::ssize_t>(n)});
-    py::array inv_inertia = new_array(d, {3, static_cast<py::ssize_t>(n)});
-    {
-      T* const im = data<T>(inv_mass);
-      const Vec3Array<T> ii = vec3<T>(inv_inertia);
-      py::gil_scoped_release release;
-      inverses_of(columns, im, ii);
-    }
+    const auto [inv_mass, inv_inertia] = inverse_arrays(columns, d);
     return py::make_tuple(inv_mass, inv_inertia);
   });
 }

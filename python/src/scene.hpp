@@ -23,10 +23,12 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "arrays.hpp"
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/io/scene_io.hpp"
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
@@ -85,6 +87,23 @@ struct Contacts {
 };
 
 /// A new collide.Bodies over copies of `b`.
+/// 1/m and 1/I of `columns` as new (N,) and (3, N) arrays of dtype `d`: the
+/// readers' inverses_of (collide/io/scene_io.hpp), without the GIL. Only m
+/// and the moments are read.
+template <class T>
+std::pair<py::array, py::array> inverse_arrays(const BodyColumns<T>& columns, Dtype d) {
+  const auto n = static_cast<py::ssize_t>(columns.count);
+  py::array inv_mass = new_array(d, {n});
+  py::array inv_inertia = new_array(d, {3, n});
+  T* const im = data<T>(inv_mass);
+  const Vec3Array<T> ii = vec3<T>(inv_inertia);
+  {
+    py::gil_scoped_release release;
+    inverses_of(columns, im, ii);
+  }
+  return {std::move(inv_mass), std::move(inv_inertia)};
+}
+
 template <class T>
 py::object bodies_object(const BodyView<const T>& b, Dtype d) {
   const std::size_t n = b.count;

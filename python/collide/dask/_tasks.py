@@ -26,6 +26,7 @@ import collide
 
 from ._files import MappedNpz, write_columns
 
+
 def local_bodies(a, b):
     """The bodies contacts ``a``, ``b`` (uint32) name, ascending, and the
     contacts' indices into that list (uint32): ``(bodies, a_local,
@@ -88,11 +89,11 @@ def on_its_threads(task):
     return run
 
 
-def _solve(bodies, contacts, options, out=None):
+def _solve(bodies, contacts, options):
     """collide.solve of an already checked scene (the client ran the checks
-    on the whole scene and chose the model there); J into ``out`` if given."""
+    on the whole scene and chose the model there)."""
     return collide.solve(bodies, contacts, model=options["model"], accuracy=options["accuracy"],
-                         threads=options["threads"], isa=options["isa"], out=out, check=False, impacts=False)
+                         threads=options["threads"], isa=options["isa"], check=False, impacts=False)
 
 
 def _part_stats(stats, contacts, bodies, started, read_seconds):
@@ -118,7 +119,7 @@ def solve_part_arrays(part, options):
 def machine():
     """What names the running kernel (Linux's boot id), or None where
     there is none: processes that give the same name share one page cache,
-    so a file one writes through a mapping is what the other reads."""
+    so what one writes into a file is what the other reads, unflushed."""
     try:
         with open("/proc/sys/kernel/random/boot_id", encoding="ascii") as f:
             return f.read().strip() or None
