@@ -51,6 +51,21 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
+/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes (v
+/// and w): the lanes of `a` and `b` are read into (BodyLanes) or written
+/// from (const BodyLanes).
+template <class M, class View, class Lanes, class F>
+COLLIDE_LANE_INLINE void velocity_fields(const View& view, Lanes& a, Lanes& b, F&& f) {
+  f(view.v.x, a.v.x, b.v.x);
+  f(view.v.y, a.v.y, b.v.y);
+  f(view.v.z, a.v.z, b.v.z);
+  if constexpr (kRotates<M>) {
+    f(view.w.x, a.w.x, b.w.x);
+    f(view.w.y, a.w.y, b.w.y);
+    f(view.w.z, a.w.z, b.w.z);
+  }
+}
+
 /// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
 /// so that the index gather and the paired load share one field list.
 template <class M, class V, bool kVelocities = true, class View, class F>
@@ -74,29 +89,14 @@ COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyL
     f(view.p.y, a.p.y, b.p.y);
     f(view.p.z, a.p.z, b.p.z);
   }
-  if constexpr (kVelocities) {  // not for the geometry of a run (run_geometry): its walk reads them
-    f(view.v.x, a.v.x, b.v.x);
-    f(view.v.y, a.v.y, b.v.y);
-    f(view.v.z, a.v.z, b.v.z);
-    if constexpr (kRotates<M>) {
-      f(view.w.x, a.w.x, b.w.x);
-      f(view.w.y, a.w.y, b.w.y);
-      f(view.w.z, a.w.z, b.w.z);
-    }
-  }
+  // Not for the geometry of a run (run_geometry): its walk reads them.
+  if constexpr (kVelocities) velocity_fields<M>(view, a, b, f);
 }
 
 /// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
 template <class M, class V, class View, class F>
 COLLIDE_LANE_INLINE void write_bodies(const View& view, const BodyLanes<M, V>& a, const BodyLanes<M, V>& b, F&& f) {
-  f(view.v.x, a.v.x, b.v.x);
-  f(view.v.y, a.v.y, b.v.y);
-  f(view.v.z, a.v.z, b.v.z);
-  if constexpr (kRotates<M>) {
-    f(view.w.x, a.w.x, b.w.x);
-    f(view.w.y, a.w.y, b.w.y);
-    f(view.w.z, a.w.z, b.w.z);
-  }
+  velocity_fields<M>(view, a, b, f);
 }
 
 /// The streaming-pairs layout: contact l of the group joins bodies
