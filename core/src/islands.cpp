@@ -81,11 +81,17 @@ struct Chunks {
 /// parent becomes its grandparent, if nobody changed it meanwhile.
 std::uint32_t find_root(std::uint32_t* parent, std::uint32_t x) {
   for (;;) {
-    std::uint32_t p = Ref(parent[x]).load(std::memory_order_relaxed);
+    const std::uint32_t p = Ref(parent[x]).load(std::memory_order_relaxed);
     if (p == x) return x;
     const std::uint32_t g = Ref(parent[p]).load(std::memory_order_relaxed);
-    if (g != p) Ref(parent[x]).compare_exchange_weak(p, g, std::memory_order_relaxed);
-    assert(g <= p && p < x);  // parents decrease towards the root
+    // Parents decrease towards the root. Checked on the values read: a
+    // failed compare-and-swap below would load parent[x] as another thread
+    // left it, possibly already below g.
+    assert(g <= p && p < x);
+    if (g != p) {
+      std::uint32_t expected = p;
+      Ref(parent[x]).compare_exchange_weak(expected, g, std::memory_order_relaxed);
+    }
     x = g;
   }
 }
