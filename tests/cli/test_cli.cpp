@@ -664,6 +664,38 @@ std::vector<std::string> sorted_rows(const std::string& text) {
   return rows;
 }
 
+/// Every body of a bodies file `collide gen` wrote, value for value, against
+/// the library's own drawing of it: draw(i, record) fills body i.
+template <class Table, class Draw>
+void expect_drawn_bodies(const Table& table, const Draw& draw) {
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    collide::BodyRecord<double> body;
+    draw(i, body);
+    const double expected[17] = {body.m,    body.I[0], body.I[1], body.I[2], body.q[0], body.q[1],
+                                 body.q[2], body.q[3], body.p[0], body.p[1], body.p[2], body.v[0],
+                                 body.v[1], body.v[2], body.w[0], body.w[1], body.w[2]};
+    for (std::size_t k = 0; k < 17; ++k) ASSERT_EQ(table.column[k][i], expected[k]) << "body " << i << " column " << k;
+  }
+}
+
+/// The same for every contact of a contacts file: draw(k, record) fills contact k.
+template <class Contacts, class Draw>
+void expect_drawn_contacts(const Contacts& contacts, const Draw& draw) {
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    collide::ContactRecord<double> c;
+    draw(k, c);
+    const auto got = contacts.record(k);
+    ASSERT_EQ(got.a, c.a) << k;
+    ASSERT_EQ(got.b, c.b) << k;
+    for (int j = 0; j < 3; ++j) {
+      ASSERT_EQ(got.c[j], c.c[j]) << k;
+      ASSERT_EQ(got.n[j], c.n[j]) << k;
+    }
+    ASSERT_EQ(got.e, c.e) << k;
+    ASSERT_EQ(got.mu, c.mu) << k;
+  }
+}
+
 TEST_F(CliTest, GenChainWritesTheLibrarysChain) {
   // --chain N: N contacts over N + 1 boxes, the values of generate.hpp's
   // chain exactly, each contact sharing a box with the one before.
@@ -678,26 +710,14 @@ TEST_F(CliTest, GenChainWritesTheLibrarysChain) {
   collide::GenerateOptions options;
   options.seed = 5;
   options.friction = true;
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    collide::BodyRecord<double> body;
-    collide::draw_chain_body(options, n, i, body);
-    const double expected[17] = {body.m,    body.I[0], body.I[1], body.I[2], body.q[0], body.q[1],
-                                 body.q[2], body.q[3], body.p[0], body.p[1], body.p[2], body.v[0],
-                                 body.v[1], body.v[2], body.w[0], body.w[1], body.w[2]};
-    for (std::size_t k = 0; k < 17; ++k) ASSERT_EQ(table.column[k][i], expected[k]) << "body " << i << " column " << k;
-  }
-  for (std::size_t k = 0; k < n; ++k) {
-    collide::ContactRecord<double> c;
+  expect_drawn_bodies(
+      table, [&](std::size_t i, collide::BodyRecord<double>& body) { collide::draw_chain_body(options, n, i, body); });
+  expect_drawn_contacts(contacts, [&](std::size_t k, collide::ContactRecord<double>& c) {
     collide::draw_chain_contact(options, n, k, c);
-    const auto got = contacts.record(k);
-    ASSERT_EQ(got.a, k);
-    ASSERT_EQ(got.b, k + 1);
-    for (int j = 0; j < 3; ++j) {
-      ASSERT_EQ(got.c[j], c.c[j]) << k;
-      ASSERT_EQ(got.n[j], c.n[j]) << k;
-    }
-    ASSERT_EQ(got.e, c.e) << k;
-    ASSERT_EQ(got.mu, c.mu) << k;
+  });
+  for (std::size_t k = 0; k < n; ++k) {
+    ASSERT_EQ(contacts.record(k).a, k);
+    ASSERT_EQ(contacts.record(k).b, k + 1);
   }
 }
 
@@ -716,28 +736,13 @@ TEST_F(CliTest, GenPileWritesTheLibrarysPile) {
   collide::GenerateOptions options;
   options.seed = 4;
   options.friction = true;
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    collide::BodyRecord<double> body;
+  expect_drawn_bodies(table, [&](std::size_t i, collide::BodyRecord<double>& body) {
     collide::draw_pile_body(options, side, i, body);
-    const double expected[17] = {body.m,    body.I[0], body.I[1], body.I[2], body.q[0], body.q[1],
-                                 body.q[2], body.q[3], body.p[0], body.p[1], body.p[2], body.v[0],
-                                 body.v[1], body.v[2], body.w[0], body.w[1], body.w[2]};
-    for (std::size_t k = 0; k < 17; ++k) ASSERT_EQ(table.column[k][i], expected[k]) << "body " << i << " column " << k;
-  }
+  });
   EXPECT_TRUE(std::isinf(table.column[0][216])) << "the ground is last and immovable";
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    collide::ContactRecord<double> c;
+  expect_drawn_contacts(contacts, [&](std::size_t k, collide::ContactRecord<double>& c) {
     collide::draw_pile_contact(options, side, k, c);
-    const auto got = contacts.record(k);
-    ASSERT_EQ(got.a, c.a) << k;
-    ASSERT_EQ(got.b, c.b) << k;
-    for (int j = 0; j < 3; ++j) {
-      ASSERT_EQ(got.c[j], c.c[j]) << k;
-      ASSERT_EQ(got.n[j], c.n[j]) << k;
-    }
-    ASSERT_EQ(got.e, c.e) << k;
-    ASSERT_EQ(got.mu, c.mu) << k;
-  }
+  });
   // Cell order: the first cell's +x, +y, +z neighbours, then the ground.
   EXPECT_EQ(contacts.record(0).b, 1U);
   EXPECT_EQ(contacts.record(1).b, 6U);
