@@ -42,6 +42,19 @@
 //    on a loaded machine (measured: the pairs rows).
 // 4. Contiguity and the largest batch: O(batches).
 //
+// One batch, found on every thread. A scene in which no movable body is in
+// two contacts (the pairs scene, the contacts of one colour of a broadphase)
+// is one batch in input order, and so is its schedule: instead of pass 2 on
+// one thread, each thread claims the movable bodies of its chunk of contacts
+// in the body table (its chunk's number, 1 to 254), failing at the first body
+// it claimed already, and after the join checks that every body of its chunk
+// still carries its number: of two chunks that claimed one body, the later
+// write stands and the other chunk sees it, in whatever order or interleaving
+// the chunks ran. Claims are relaxed atomic bytes; the check decides.
+// Any failure (a shared body, a bad index) hands the scene to the passes
+// above, which refill the table and name the first bad contact; a scattered
+// scene fails within its first few thousand contacts.
+//
 // The level pass is bound by the random reads of the body table: a prefetch
 // 16 contacts ahead hides them (8 leaves misses exposed, 16 to 64 are alike),
 // and the table is kept in bytes (docs/decisions/0015-the-schedules-level-pass.md
@@ -51,6 +64,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -114,13 +128,9 @@ __attribute__((noinline, cold)) void throw_bad_contact(const BodyIndex* a, const
     const std::string at = "[" + std::to_string(k) + "] = ";
     const std::string range = ": out of range (" + std::to_string(body_count) + " bodies)";
     std::string what = "collide::Schedule::build: contacts.";
-    if (a[k] >= body_count) {
-      what += "a" + at + std::to_string(a[k]) + range;
-    } else if (b[k] >= body_count) {
-      what += "b" + at + std::to_string(b[k]) + range;
-    } else {
-      what += "b" + at + std::to_string(b[k]) + ": a contact of a body with itself";
-    }
+    const bool a_bad = a[k] >= body_count;
+    what.append(a_bad ? "a" : "b").append(at).append(std::to_string(a_bad ? a[k] : b[k]));
+    what.append(a_bad || b[k] >= body_count ? range : std::string(": a contact of a body with itself"));
     throw std::invalid_argument(what);
   }
 }
@@ -300,6 +310,123 @@ void scatter_by_level(const Level* level, std::size_t begin, std::size_t end, st
   }
 }
 
+/// The chunks of the one-batch test: each marks its bodies with its number
+/// (1 .. 254) in the byte body table, below the immovable sentinel.
+constexpr std::size_t kMaxClaimChunks = kImmovableWord<std::uint8_t> - 1;
+
+/// One batch, step 1, for contacts [begin, end) of chunk `id`: claims every
+/// movable body in `table` (zeroed), marks immovable ones with the sentinel.
+/// False at the first bad index block, body this chunk claimed already, or
+/// when another chunk has failed (`failed`, checked once per block).
+template <class T>
+bool claim_bodies(const BodyIndex* a, const BodyIndex* b, std::size_t begin, std::size_t end, BodyIndex bound,
+                  const T* inv_mass, std::size_t stride, std::uint8_t* table, std::uint8_t id,
+                  const std::atomic<bool>& failed) {
+  constexpr std::uint8_t immovable = kImmovableWord<std::uint8_t>;
+  const auto claim = [&](BodyIndex i) {
+    std::atomic_ref<std::uint8_t> word(table[i]);
+    const std::uint8_t w = word.load(std::memory_order_relaxed);
+    if (w == immovable) return true;
+    if (w == id) return false;  // a repeat within the chunk
+    // Another chunk's number is overwritten: owns_bodies finds the body
+    // shared, whichever chunk wrote last, in any order the chunks ran.
+    word.store(w == 0 && is_immovable(inv_mass[i * stride]) ? immovable : id, std::memory_order_relaxed);
+    return true;
+  };
+  for (std::size_t k = begin; k < end;) {
+    const std::size_t block_end = std::min(end, k + kCheckBlock);
+    if (failed.load(std::memory_order_relaxed) || !indices_below(a + k, b + k, block_end - k, bound)) return false;
+    for (; k < block_end; ++k) {
+      if (!claim(a[k]) || !claim(b[k])) return false;
+    }
+  }
+  return true;
+}
+
+/// One batch, step 2, after every chunk has claimed: whether every body of
+/// contacts [begin, end) still carries chunk `id`'s number (or is immovable).
+inline bool owns_bodies(const BodyIndex* a, const BodyIndex* b, std::size_t begin, std::size_t end, std::uint8_t* table,
+                        std::uint8_t id) {
+  constexpr std::uint8_t immovable = kImmovableWord<std::uint8_t>;
+  bool owned = true;
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint8_t wa = std::atomic_ref<std::uint8_t>(table[a[k]]).load(std::memory_order_relaxed);
+    const std::uint8_t wb = std::atomic_ref<std::uint8_t>(table[b[k]]).load(std::memory_order_relaxed);
+    owned &= (wa == id || wa == immovable) & (wb == id || wb == immovable);
+  }
+  return owned;
+}
+
+/// Contacts the one-batch test looks at first, on the calling thread, before
+/// it touches the body table: a pile or a chain repeats a body within its
+/// first two contacts, debris (4096 contacts of random bodies) with a
+/// probability above 0.99, and then the test costs no pass over the bodies.
+constexpr std::size_t kOneBatchProbe = 4096;
+
+/// Whether a movable body is in two of the first `probe` contacts (or an
+/// index is bad): an open-addressing set of their bodies in `set` (resized,
+/// 64 KiB, in L2; the schedule's scratch, kept between builds).
+template <class T>
+bool probe_repeats(const BodyIndex* a, const BodyIndex* b, std::size_t probe, BodyIndex bound, const T* inv_mass,
+                   std::size_t stride, std::vector<std::uint32_t>& set) {
+  if (!indices_below(a, b, probe, bound)) return true;
+  constexpr int kSlotBits = 14;
+  constexpr std::size_t kSlots = std::size_t{1} << kSlotBits;
+  static_assert(kSlots >= 4 * kOneBatchProbe, "the set stays at most half full");
+  constexpr BodyIndex kEmpty = std::numeric_limits<BodyIndex>::max();
+  set.assign(kSlots, kEmpty);
+  const auto insert = [&](BodyIndex i) {
+    if (is_immovable(inv_mass[i * stride])) return true;
+    // Fibonacci hashing: the top kSlotBits bits of i times 2^64 / golden ratio.
+    for (std::size_t s = (std::uint64_t{i} * 0x9E3779B97F4A7C15u) >> (64 - kSlotBits);; s = (s + 1) % kSlots) {
+      if (set[s] == i) return false;
+      if (set[s] == kEmpty) {
+        set[s] = i;
+        return true;
+      }
+    }
+  };
+  for (std::size_t k = 0; k < probe; ++k) {
+    if (!insert(a[k]) || !insert(b[k])) return true;
+  }
+  return false;
+}
+
+/// Whether the scene is one batch in input order, found on up to `workers`
+/// threads (the design notes, "One batch"); if so, `order` is the identity.
+/// Needs two chunks at least; `table` holds a byte per body, `scratch` is
+/// the probe's (probe_repeats).
+template <class T>
+bool one_batch(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, std::size_t stride,
+               std::size_t workers, std::uint8_t* table, std::uint32_t* order, std::vector<std::uint32_t>& scratch) {
+  const std::size_t n = contacts.count;
+  const std::size_t chunks = std::min(chunk_count(n, workers), kMaxClaimChunks);
+  if (chunks < 2) return false;
+  const auto bound = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
+  if (probe_repeats(contacts.a, contacts.b, std::min(n, kOneBatchProbe), bound, inv_mass, stride, scratch)) {
+    return false;
+  }
+  for_each_chunk(body_count, chunk_count(body_count, workers), [&](std::size_t, std::size_t begin, std::size_t end) {
+    std::fill(table + begin, table + end, std::uint8_t{0});
+  });
+  std::atomic<bool> failed{false};
+  for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    const auto id = static_cast<std::uint8_t>(c + 1);
+    if (!claim_bodies(contacts.a, contacts.b, begin, end, bound, inv_mass, stride, table, id, failed)) {
+      failed.store(true, std::memory_order_relaxed);
+    }
+  });
+  if (failed.load(std::memory_order_relaxed)) return false;
+  for_each_chunk(n, chunks, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    if (!owns_bodies(contacts.a, contacts.b, begin, end, table, static_cast<std::uint8_t>(c + 1))) {
+      failed.store(true, std::memory_order_relaxed);
+      return;
+    }
+    std::iota(order + begin, order + end, static_cast<std::uint32_t>(begin));
+  });
+  return !failed.load(std::memory_order_relaxed);
+}
+
 /// Turns the first `count` bytes of `words` into `count` words, the byte
 /// sentinel into the word sentinel.
 void widen(std::vector<std::uint32_t>& words, std::size_t count) {
@@ -363,6 +490,15 @@ void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_co
     body_next_.resize((body_count + 3) / 4);
     level_.resize((n + 3) / 4);
     auto* const next8 = reinterpret_cast<std::uint8_t*>(body_next_.data());
+    if (one_batch(contacts, body_count, inv_mass, stride, workers, next8, order_.data(), slot_)) {
+      // What passes 2 to 4 give a scene of one level.
+      batch_begin_.assign({std::uint32_t{0}, static_cast<std::uint32_t>(n)});
+      contiguous_.assign(1, 1);
+      largest_batch_ = n;
+      contact_count_ = n;
+      body_count_ = body_count;
+      return;
+    }
     fill_body_table(inv_mass, stride, 0, body_count, next8);
     std::uint32_t levels = 0;
     std::size_t conflicts = 0;

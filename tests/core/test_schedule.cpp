@@ -327,6 +327,27 @@ Topology pairs_topology(std::size_t n) {
   return t;
 }
 
+/// pairs_topology(n) with contact `later` joined to a body of contact
+/// `earlier` instead of its own b: one movable body repeats, once.
+Topology pairs_sharing(std::size_t n, std::size_t earlier, std::size_t later) {
+  Topology t = pairs_topology(n);
+  t.name += ", contact " + std::to_string(later) + " shares a body with " + std::to_string(earlier);
+  t.b[later] = t.a[earlier];
+  return t;
+}
+
+/// n contacts, each of a body of its own with the ground (the last body,
+/// immovable) on side b: one batch.
+Topology on_the_ground_topology(std::size_t n) {
+  Topology t{"on the ground n=" + std::to_string(n), {}, {}, std::vector<float>(n + 1, 1.0f)};
+  t.inv_mass[n] = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    t.a.push_back(static_cast<BodyIndex>(k));
+    t.b.push_back(static_cast<BodyIndex>(n));
+  }
+  return t;
+}
+
 /// Every contact shares movable body 0 (on either side): one batch per contact.
 Topology all_shared_topology(std::size_t n) {
   Topology t{"all shared n=" + std::to_string(n), {}, {}, std::vector<float>(n + 1, 1.0f)};
@@ -376,6 +397,13 @@ TEST(Schedule, EqualsPlainLevelRuleOnEveryShapeAndThreadCount) {
       debris_topology(3000, 3),
       pairs_topology(100000),
       pairs_topology(10),
+      // One batch is looked for on every thread (schedule.cpp, "One batch"):
+      // a body repeated after the probe, within a chunk or across two (each
+      // chunk's claims alone succeed), and one batch on an immovable body.
+      pairs_sharing(100000, 5000, 20000),
+      pairs_sharing(100000, 10000, 90000),
+      pairs_sharing(100000, 99998, 99999),
+      on_the_ground_topology(80000),
       all_shared_topology(5000),
       random_topology(140000, 60000, 0.2, 4),   // immovable bodies at random, ~10 contacts per body
       random_topology(70000, 700, 0.1, 5),      // dense: hundreds of batches, still split on 2 threads
@@ -501,6 +529,31 @@ TEST(Schedule, PackedRecordsGiveTheSameSchedule) {
       s.build(view, packed_view(particle), threads);
       expect_reference(t, s);
     }
+  }
+}
+
+// A bad index past the one-batch probe, in either chunk of a scene the
+// threads test for one batch: the build names the first, as validate() does,
+// whatever the thread count.
+TEST(Schedule, FirstBadIndexIsNamedOnEveryThreadCount) {
+  for (const int threads : {1, 2, 3, 0}) {
+    Topology t = pairs_topology(100000);
+    t.a[90000] = static_cast<BodyIndex>(t.inv_mass.size());
+    t.b[70000] = t.a[70000];
+    ContactView<float> view;
+    view.count = t.a.size();
+    view.a = t.a.data();
+    view.b = t.b.data();
+    Schedule s;
+    std::string message;
+    try {
+      s.build(view, t.inv_mass.size(), t.inv_mass.data(), threads);
+    } catch (const std::invalid_argument& e) {
+      message = e.what();
+    }
+    EXPECT_EQ(message, "collide::Schedule::build: contacts.b[70000] = 140000: a contact of a body with itself")
+        << "threads " << threads;
+    EXPECT_EQ(s.batch_count(), 0u);
   }
 }
 

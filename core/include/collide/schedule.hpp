@@ -36,7 +36,10 @@
 //
 // Building is sequential where it must be: the batch of contact k depends on
 // every earlier contact, so one pass in input order assigns batches (with the
-// body words it will need prefetched, schedule.cpp). Grouping contacts by
+// body words it will need prefetched, schedule.cpp). A scene in which no
+// movable body is in two contacts (independent pairs) is found to be one
+// batch on every thread instead, in one pass over the contacts and a check
+// (schedule.cpp, "One batch"). Grouping contacts by
 // batch is a stable counting sort that runs on threads, in the task arena of
 // the calling thread (TBB's default arena unless called inside a
 // tbb::task_arena::execute), or on at most `threads` threads. The schedule is
@@ -148,7 +151,7 @@ class Schedule {
   std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body (bytes, likewise)
   std::vector<std::uint32_t> batch_begin_;
   std::vector<std::uint8_t> contiguous_;
-  std::vector<std::uint32_t> slot_;  // scratch: per-chunk counts, then slots, of the parallel sort
+  std::vector<std::uint32_t> slot_;  // scratch: per-chunk counts, then slots, of the parallel sort; the one-batch probe
 };
 
 extern template void Schedule::build<float>(const ContactView<float>&, std::size_t, const float*, int);
