@@ -13,6 +13,7 @@
 //   another one writes, so the result is the same for any thread count.
 #include "collide/io/scene_io.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <optional>
@@ -41,6 +42,23 @@ void BodyTable<T>::push_back(const BodyRecord<T>& body) {
   for (int k = 0; k < 3; ++k) column[wx + k].push_back(body.w[k]);
 }
 
+/// The least positive T whose reciprocal is finite: for x > 0, 1/x is
+/// finite exactly when x >= it (1/x does not increase with x). Found once,
+/// from 1/max by stepping through neighbouring values, in the arithmetic
+/// the rule uses (1/x overflows, so not at compile time).
+template <class T>
+T least_with_finite_inverse() {
+  static const T least = [] {
+    constexpr T max = std::numeric_limits<T>::max();
+    const auto finite_inverse = [](T x) { return T(1) / x <= max; };
+    T x = T(1) / max;
+    while (finite_inverse(std::nextafter(x, T(0)))) x = std::nextafter(x, T(0));
+    while (!finite_inverse(x)) x = std::nextafter(x, max);
+    return x;
+  }();
+  return least;
+}
+
 template <class T>
 bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) noexcept {
   // The rules of body_ok (collide/rules.hpp), one column at a time and
@@ -50,9 +68,10 @@ bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) no
   unsigned bad = 0;
   for (std::size_t k = 0; k < 4; ++k) {  // m and the moments: > 0 with a finite inverse (inf is allowed)
     const T* x = columns.column[k];
-    for (std::size_t i = i0; i < i1; ++i) {
-      bad |= static_cast<unsigned>(!(x[i] > T(0))) | static_cast<unsigned>(!finite(T(1) / x[i]));
-    }
+    // x >= the least value with a finite inverse: 1/x finite, and x > 0
+    // (NaN compares false), without a division per value.
+    const T least = least_with_finite_inverse<T>();
+    for (std::size_t i = i0; i < i1; ++i) bad |= static_cast<unsigned>(!(x[i] >= least));
   }
   for (std::size_t k = 4; k < columns.column.size(); ++k) {
     const T* x = columns.column[k];
@@ -105,16 +124,20 @@ void inverses_of(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>&
   using Range = oneapi::tbb::blocked_range<std::size_t>;
   // As BodyBuffer::set: 1/inf = 0, and an immovable body has no inverse
   // moments whatever its I (the law).
+  // Column by column through restrict pointers, so that each loop
+  // vectorises without run-time alias checks. 1/inf is +0, so the inverse
+  // mass needs no select.
   oneapi::tbb::parallel_for(Range(0, columns.count, 1 << 16), [&](const Range& r) {
     const T inf = std::numeric_limits<T>::infinity();
-    for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const T m = columns.column[0][i];
-      const bool immovable = m == inf;
-      inv_mass[i] = immovable ? T(0) : T(1) / m;
-      const T ix = columns.column[1][i], iy = columns.column[2][i], iz = columns.column[3][i];
-      inv_inertia.x[i] = immovable || ix == inf ? T(0) : T(1) / ix;
-      inv_inertia.y[i] = immovable || iy == inf ? T(0) : T(1) / iy;
-      inv_inertia.z[i] = immovable || iz == inf ? T(0) : T(1) / iz;
+    const std::size_t i0 = r.begin(), i1 = r.end();
+    const T* __restrict const m = columns.column[0];
+    T* __restrict const im = inv_mass;
+    for (std::size_t i = i0; i < i1; ++i) im[i] = T(1) / m[i];
+    T* const out[3] = {inv_inertia.x, inv_inertia.y, inv_inertia.z};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const T* __restrict const moment = columns.column[1 + k];
+      T* __restrict const inverse = out[k];
+      for (std::size_t i = i0; i < i1; ++i) inverse[i] = m[i] == inf ? T(0) : T(1) / moment[i];
     }
   });
 }

@@ -16,6 +16,8 @@
 //   arrays in kernel units, collide/rules.hpp for physical units).
 #pragma once
 
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -105,8 +107,20 @@ py::array copy_rows(const py::dtype& dtype, const T* const* rows, std::size_t ro
   std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(n)};
   if (row_count != 1) shape.insert(shape.begin(), static_cast<py::ssize_t>(row_count));
   py::array a(dtype, shape);
-  T* o = data<T>(a);
-  for (std::size_t r = 0; r < row_count; ++r) o = std::copy(rows[r], rows[r] + n, o);
+  T* const o = data<T>(a);
+  // On TBB's threads without the GIL: a new array's first touch (the kernel
+  // zeroing its pages) costs as much as the copy, and both spread over cores.
+  constexpr std::size_t kGrain = std::size_t{1} << 16;
+  const auto copy = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = 0; r < row_count; ++r) std::copy(rows[r] + begin, rows[r] + end, o + r * n + begin);
+  };
+  if (n < 2 * kGrain) {
+    copy(0, n);
+  } else {
+    py::gil_scoped_release release;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kGrain),
+                      [&](const tbb::blocked_range<std::size_t>& r) { copy(r.begin(), r.end()); });
+  }
   return a;
 }
 template <class T>

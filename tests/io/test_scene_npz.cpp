@@ -249,8 +249,18 @@ namespace {
 template <class T>
 std::vector<T> edge_values() {
   using L = std::numeric_limits<T>;
-  return {T(0),     -T(0),    T(1),     -T(1),   L::infinity(), -L::infinity(), L::quiet_NaN(), L::denorm_min(),
-          L::min(), L::max(), T(1e-20), T(1e20), T(0.5),        T(1.0005),      T(1.002),       T(0.9985)};
+  std::vector<T> values{T(0),           -T(0),           T(1),     -T(1),    L::infinity(), -L::infinity(),
+                        L::quiet_NaN(), L::denorm_min(), L::min(), L::max(), T(1e-20),      T(1e20),
+                        T(0.5),         T(1.0005),       T(1.002), T(0.9985)};
+  // Where 1/x overflows (a subnormal near 1/max): the values around it,
+  // which the columnar screen compares with a threshold instead of dividing.
+  T below = T(1) / L::max(), above = below;
+  for (int step = 0; step < 4; ++step) {
+    values.push_back(below = std::nextafter(below, T(0)));
+    values.push_back(above = std::nextafter(above, L::max()));
+  }
+  values.push_back(T(1) / L::max());
+  return values;
 }
 
 /// Rows of the screen tests: whole SIMD blocks and a tail.
