@@ -429,7 +429,7 @@ bool one_batch(const ContactView<T>& contacts, std::size_t body_count, const T* 
 
 /// Turns the first `count` bytes of `words` into `count` words, the byte
 /// sentinel into the word sentinel.
-void widen(std::vector<std::uint32_t>& words, std::size_t count) {
+void widen(Labels& words, std::size_t count) {
   words.resize(count);  // keeps the bytes of the narrow words
   std::uint32_t* const wide = words.data();
   const auto* const narrow = reinterpret_cast<const std::uint8_t*>(wide);

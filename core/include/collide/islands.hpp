@@ -49,37 +49,10 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/labels.hpp"
 #include "collide/packed.hpp"
 
 namespace collide {
-
-/// The allocator of the label arrays of Islands: std::allocator's, except
-/// that resize() leaves the new values uninitialised (islands() writes every
-/// one in its parallel passes; a std::vector would first zero them on one
-/// thread, a third of the whole pass at 16M contacts) and that arrays of
-/// 2 MiB or more are asked for 2 MiB pages where the system has them.
-struct LabelAllocator {
-  using value_type = std::uint32_t;
-  template <class U>
-  struct rebind {  // for std::vector<std::uint32_t> only
-    static_assert(std::is_same_v<U, std::uint32_t>, "LabelAllocator allocates labels");
-    using other = LabelAllocator;
-  };
-
-  [[nodiscard]] std::uint32_t* allocate(std::size_t n);
-  void deallocate(std::uint32_t* p, std::size_t n) noexcept;
-  /// Value-initialisation (resize(n)) leaves the value as it is.
-  void construct(std::uint32_t* p) noexcept { ::new (static_cast<void*>(p)) std::uint32_t; }
-  template <class... Args>
-  void construct(std::uint32_t* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) std::uint32_t(std::forward<Args>(args)...);
-  }
-  friend bool operator==(const LabelAllocator&, const LabelAllocator&) noexcept { return true; }
-  friend bool operator!=(const LabelAllocator&, const LabelAllocator&) noexcept { return false; }
-};
-
-/// One label (or count) per contact, body or island.
-using Labels = std::vector<std::uint32_t, LabelAllocator>;
 
 /// The islands of a contact set (islands()).
 struct Islands {

@@ -59,6 +59,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/labels.hpp"
 #include "collide/packed.hpp"
 
 namespace collide {
@@ -146,9 +147,12 @@ class Schedule {
   template <class Level>
   void sort_by_level(const Level* level, std::uint32_t levels, std::size_t workers, bool runs);
 
-  std::vector<std::uint32_t> order_;
-  std::vector<std::uint32_t> level_;      // scratch: batch of each contact (bytes while batches < 254)
-  std::vector<std::uint32_t> body_next_;  // scratch: first free batch of each body (bytes, likewise)
+  // Uninitialised when they grow (labels.hpp): every build writes all it
+  // reads of them, and the first touch of a fresh one happens in those
+  // passes, on every thread where they run on every thread.
+  Labels order_;
+  Labels level_;      // scratch: batch of each contact (bytes while batches < 254)
+  Labels body_next_;  // scratch: first free batch of each body (bytes, likewise)
   std::vector<std::uint32_t> batch_begin_;
   std::vector<std::uint8_t> contiguous_;
   std::vector<std::uint32_t> slot_;  // scratch: per-chunk counts, then slots, of the parallel sort; the one-batch probe
