@@ -359,7 +359,7 @@ inline bool owns_bodies(const BodyIndex* a, const BodyIndex* b, std::size_t begi
 
 /// Contacts the one-batch test looks at first, on the calling thread, before
 /// it touches the body table: a pile or a chain repeats a body within its
-/// first two contacts, debris (4096 contacts of random bodies) with a
+/// first two contacts, the debris scene of 2M bodies within 4096 with a
 /// probability above 0.99, and then the test costs no pass over the bodies.
 constexpr std::size_t kOneBatchProbe = 4096;
 
