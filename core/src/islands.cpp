@@ -1,4 +1,5 @@
-// islands.cpp - the islands of islands.hpp, in six parallel passes.
+// islands.cpp - the islands of islands.hpp, in six parallel passes (three
+// when no movable body is in two contacts: single_contact_islands).
 //
 // 1. Parents (over bodies): parent[i] = i for a movable body, kNone for an
 //    immovable one, which no contact links to anything.
@@ -50,6 +51,7 @@
 
 #include "chunks.hpp"
 #include "collide/validate.hpp"
+#include "repeated_bodies.hpp"
 
 namespace collide {
 namespace {
@@ -113,6 +115,69 @@ inline std::uint32_t contact_root(const std::uint32_t* parent, BodyIndex a, Body
   return ra != kNone ? ra : parent[b];
 }
 
+/// Contacts whose movable bodies are in no other contact (the pairs scene)
+/// are each an island of their own, numbered as they come: whether that is
+/// so, and then `out` filled, in three passes instead of six. Each contact
+/// writes its number into its movable bodies' labels (failing at a label an
+/// earlier contact of its chunk wrote); then each contact checks that its
+/// bodies still carry its number: of two contacts that wrote one body, the
+/// later write stands and the other sees it, in any order or interleaving
+/// of the chunks.
+/// Immovable bodies are never written and keep kNone. On false, `out` is
+/// half written and the caller starts over.
+template <class T>
+bool single_contact_islands(const BodyIndex* a, const BodyIndex* b, std::size_t m, const T* inv_mass,
+                            std::size_t stride, const Chunks& body_chunks, const Chunks& contact_chunks, Islands& out) {
+  std::vector<std::uint32_t> scratch;
+  if (m == 0 || detail::movable_body_repeats(a, b, std::min(m, detail::kRepeatProbe), inv_mass, stride, scratch)) {
+    return false;
+  }
+  std::uint32_t* const body = out.body_island.data();
+  body_chunks.run([&](std::size_t, std::size_t begin, std::size_t end) { std::fill(body + begin, body + end, kNone); });
+  constexpr std::size_t kBlock = 4096;  // contacts between looks at `failed`
+  std::atomic<bool> failed{false};
+  contact_chunks.run([&](std::size_t, std::size_t begin, std::size_t end) {
+    // Another chunk's number is overwritten, not a failure: the check
+    // below then finds the body shared whichever chunk ran first.
+    const auto claim = [&](BodyIndex i, std::uint32_t k) {
+      if (is_immovable(inv_mass[i * stride])) return true;
+      Ref slot(body[i]);
+      const std::uint32_t seen = slot.load(std::memory_order_relaxed);
+      if (seen >= begin && seen < k) return false;  // a repeat within the chunk
+      slot.store(k, std::memory_order_relaxed);
+      return true;
+    };
+    for (std::size_t k = begin; k < end; ++k) {
+      if (k % kBlock == 0 && failed.load(std::memory_order_relaxed)) return;
+      const auto kk = static_cast<std::uint32_t>(k);
+      if (!claim(a[k], kk) || !claim(b[k], kk)) {
+        failed.store(true, std::memory_order_relaxed);
+        return;
+      }
+    }
+  });
+  if (failed.load(std::memory_order_relaxed)) return false;
+  out.island_contacts.resize(m);
+  std::uint32_t* const label = out.contact_island.data();
+  std::uint32_t* const sizes = out.island_contacts.data();
+  contact_chunks.run([&](std::size_t, std::size_t begin, std::size_t end) {
+    bool own = true;
+    for (std::size_t k = begin; k < end; ++k) {
+      const auto kk = static_cast<std::uint32_t>(k);
+      const std::uint32_t la = Ref(body[a[k]]).load(std::memory_order_relaxed);
+      const std::uint32_t lb = Ref(body[b[k]]).load(std::memory_order_relaxed);
+      own &= (la == kk || la == kNone) & (lb == kk || lb == kNone);
+      label[k] = kk;
+      sizes[k] = 1;
+    }
+    if (!own) failed.store(true, std::memory_order_relaxed);
+  });
+  if (failed.load(std::memory_order_relaxed)) return false;
+  out.largest = 1;
+  out.largest_island = 0;
+  return true;
+}
+
 void check_arguments(std::size_t contact_count, const BodyIndex* a, const BodyIndex* b, std::size_t body_count,
                      const void* inv_mass, int threads) {
   const std::string who = "collide::islands: ";
@@ -155,9 +220,11 @@ Islands islands_strided(const ContactView<T>& contacts, std::size_t body_count, 
   // first touched.
   Islands out;
   out.contact_island.resize(m);
+  out.body_island.resize(body_count);
+  if (single_contact_islands(a, b, m, inv_mass, stride, body_chunks, contact_chunks, out)) return out;
+
   // Pass 1. body_island is the union-find's parent array until pass 6
   // turns it into labels.
-  out.body_island.resize(body_count);
   Labels first;  // pass 4's, set to kNone here
   first.resize(body_count);
   std::uint32_t* const parent = out.body_island.data();

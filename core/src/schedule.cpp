@@ -74,6 +74,7 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include "chunks.hpp"
+#include "repeated_bodies.hpp"
 
 namespace collide {
 namespace {
@@ -357,45 +358,10 @@ inline bool owns_bodies(const BodyIndex* a, const BodyIndex* b, std::size_t begi
   return owned;
 }
 
-/// Contacts the one-batch test looks at first, on the calling thread, before
-/// it touches the body table: a pile or a chain repeats a body within its
-/// first two contacts, the debris scene of 2M bodies within 4096 with a
-/// probability above 0.99, and then the test costs no pass over the bodies.
-constexpr std::size_t kOneBatchProbe = 4096;
-
-/// Whether a movable body is in two of the first `probe` contacts (or an
-/// index is bad): an open-addressing set of their bodies in `set` (resized,
-/// 64 KiB, in L2; the schedule's scratch, kept between builds).
-template <class T>
-bool probe_repeats(const BodyIndex* a, const BodyIndex* b, std::size_t probe, BodyIndex bound, const T* inv_mass,
-                   std::size_t stride, std::vector<std::uint32_t>& set) {
-  if (!indices_below(a, b, probe, bound)) return true;
-  constexpr int kSlotBits = 14;
-  constexpr std::size_t kSlots = std::size_t{1} << kSlotBits;
-  static_assert(kSlots >= 4 * kOneBatchProbe, "the set stays at most half full");
-  constexpr BodyIndex kEmpty = std::numeric_limits<BodyIndex>::max();
-  set.assign(kSlots, kEmpty);
-  const auto insert = [&](BodyIndex i) {
-    if (is_immovable(inv_mass[i * stride])) return true;
-    // Fibonacci hashing: the top kSlotBits bits of i times 2^64 / golden ratio.
-    for (std::size_t s = (std::uint64_t{i} * 0x9E3779B97F4A7C15u) >> (64 - kSlotBits);; s = (s + 1) % kSlots) {
-      if (set[s] == i) return false;
-      if (set[s] == kEmpty) {
-        set[s] = i;
-        return true;
-      }
-    }
-  };
-  for (std::size_t k = 0; k < probe; ++k) {
-    if (!insert(a[k]) || !insert(b[k])) return true;
-  }
-  return false;
-}
-
 /// Whether the scene is one batch in input order, found on up to `workers`
 /// threads (the design notes, "One batch"); if so, `order` is the identity.
 /// Needs two chunks at least; `table` holds a byte per body, `scratch` is
-/// the probe's (probe_repeats).
+/// the probe's (repeated_bodies.hpp).
 template <class T>
 bool one_batch(const ContactView<T>& contacts, std::size_t body_count, const T* inv_mass, std::size_t stride,
                std::size_t workers, std::uint8_t* table, std::uint32_t* order, std::vector<std::uint32_t>& scratch) {
@@ -403,7 +369,10 @@ bool one_batch(const ContactView<T>& contacts, std::size_t body_count, const T* 
   const std::size_t chunks = std::min(chunk_count(n, workers), kMaxClaimChunks);
   if (chunks < 2) return false;
   const auto bound = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
-  if (probe_repeats(contacts.a, contacts.b, std::min(n, kOneBatchProbe), bound, inv_mass, stride, scratch)) {
+  // A first look, on the calling thread, before the body table is touched.
+  const std::size_t probe = std::min(n, detail::kRepeatProbe);
+  if (!indices_below(contacts.a, contacts.b, probe, bound) ||
+      detail::movable_body_repeats(contacts.a, contacts.b, probe, inv_mass, stride, scratch)) {
     return false;
   }
   for_each_chunk(body_count, chunk_count(body_count, workers), [&](std::size_t, std::size_t begin, std::size_t end) {

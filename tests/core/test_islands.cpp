@@ -218,6 +218,43 @@ TEST(Islands, SameForEveryThreadCount) {
   }
 }
 
+// Contacts whose movable bodies are in no other contact are each an island
+// (islands.cpp, single_contact_islands): independent pairs, some bodies
+// immovable or without contacts, some contacts between two immovable
+// bodies; and the same with one body repeated after the first look at the
+// scene, within a chunk, across chunks, and in the last two contacts, which
+// the general passes then label.
+TEST(Islands, IndependentContactsAreEachAnIsland) {
+  const tbb::global_control parallelism(tbb::global_control::max_allowed_parallelism, 8);
+  const std::size_t m = 100000;
+  const std::size_t n = 2 * m + 7;  // the last bodies have no contact
+  std::vector<bool> immovable(n, false);
+  Edges pairs;
+  for (std::size_t k = 0; k < m; ++k) {
+    pairs.emplace_back(static_cast<BodyIndex>(2 * k), static_cast<BodyIndex>(2 * k + 1));
+    if (k % 7 == 3) immovable[2 * k] = true;
+    if (k % 11 == 5) immovable[2 * k + 1] = true;
+  }
+  std::vector<Edges> scenes{pairs};
+  for (const auto& [earlier, later] : std::vector<std::pair<std::size_t, std::size_t>>{
+           {5000, 20000}, {10000, 90000}, {99998, 99999}, {60001, 60000}}) {
+    Edges shared = pairs;
+    // A movable body of the earlier contact in place of the later's b.
+    const BodyIndex body = immovable[pairs[earlier].first] ? pairs[earlier].second : pairs[earlier].first;
+    ASSERT_FALSE(immovable[body]);
+    shared[later].second = body;
+    scenes.push_back(shared);
+  }
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const Islands want = plain_islands(n, scenes[s], immovable);
+    EXPECT_EQ(want.count(), s == 0 ? m : m - 1) << "scene " << s;
+    for (const int threads : {1, 2, 3, 8}) {
+      SCOPED_TRACE("scene " + std::to_string(s) + ", threads " + std::to_string(threads));
+      expect_same(islands_of(n, scenes[s], immovable, threads), want);
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Scenes with many islands, and solving them island by island.
 // ---------------------------------------------------------------------------
