@@ -19,11 +19,13 @@
 //   the member's .npy bytes start at a multiple of kNpzAlignment. NumPy pads
 //   the .npy header of a 1-D array to a multiple of 64 bytes, so the array
 //   data that follows is aligned too.
-// * The writer never seeks, so the CRC-32 that the local header holds must
+// * One pass in file order, so the CRC-32 that the local header holds must
 //   be known before the data is written: every member's is computed first,
 //   the members in parallel, each by libdeflate (carry-less multiplication
 //   where the CPU has it, about four times zlib's speed), and
-//   the data is then written straight from the caller's array.
+//   the data is then written straight from the caller's array: to a file
+//   under a temporary name at its offsets, in 8 MiB slices on every thread
+//   (pwrite), to a stream or a device in order.
 #include "collide/io/npz.hpp"
 
 #include <libdeflate.h>
@@ -31,6 +33,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -273,7 +276,32 @@ void write_archive(const std::vector<NpzColumn>& columns, Sink&& sink) {
 }  // namespace
 
 void write_npz(OutputFile& out, const std::vector<NpzColumn>& columns) {
-  write_archive(columns, [&](std::string_view bytes) { out.write(bytes); });
+  if (out.direct()) {
+    write_archive(columns, [&](std::string_view bytes) { out.write(bytes); });
+    return;
+  }
+  // A file under a temporary name: every piece goes to its offset, the
+  // large ones in slices on every thread. Writing new page-cache pages is
+  // bound by allocating and filling them, which one thread did at 0.4 GB/s
+  // on a VM that hands free memory back to its host.
+  constexpr std::size_t kSlice = std::size_t{8} << 20;
+  struct Piece {
+    std::uint64_t offset;
+    std::string_view bytes;
+  };
+  std::deque<std::string> copies;  // the headers: the sink's strings are temporaries
+  std::vector<Piece> pieces;
+  std::uint64_t offset = 0;
+  write_archive(columns, [&](std::string_view bytes) {
+    // Only a member's data reaches a slice's size, and it is the caller's.
+    if (bytes.size() < kSlice) bytes = copies.emplace_back(bytes);
+    for (std::size_t at = 0; at < bytes.size(); at += kSlice) {
+      pieces.push_back(Piece{offset + at, bytes.substr(at, kSlice)});
+    }
+    offset += bytes.size();
+  });
+  oneapi::tbb::parallel_for(std::size_t{0}, pieces.size(),
+                            [&](std::size_t k) { out.write_at(pieces[k].offset, pieces[k].bytes); });
 }
 
 std::string format_npz(const std::vector<NpzColumn>& columns) {

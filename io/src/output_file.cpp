@@ -157,6 +157,18 @@ void OutputFile::write(std::string_view bytes) {
   }
 }
 
+void OutputFile::write_at(std::uint64_t offset, std::string_view bytes) const {
+  if (file_ == nullptr || temp_path_.empty()) throw SceneError(path_, "positional write to a direct or closed output");
+  const int fd = ::fileno(file_);
+  while (!bytes.empty()) {
+    const ssize_t n = ::pwrite(fd, bytes.data(), bytes.size(), static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw SceneError(path_, errno_text("write error", n < 0 ? errno : EIO));
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+    offset += static_cast<std::uint64_t>(n);
+  }
+}
+
 void OutputFile::commit() {
   if (file_ == nullptr) throw SceneError(path_, "commit without an open file");
   if (!temp_path_.empty()) {

@@ -546,6 +546,25 @@ TEST_F(NpzFileTest, WriteNpzIsFormatNpzAndMapsAligned) {
   }
 }
 
+// A file is written at offsets, members in 8 MiB slices on every thread
+// (npz_write.cpp): members of several slices, one ending mid-slice, an
+// empty one between them, give format_npz's bytes.
+TEST_F(NpzFileTest, WriteNpzOfMembersOfManySlicesIsFormatNpz) {
+  std::vector<float> f(5'000'003);
+  std::vector<double> d(3'000'001);
+  for (std::size_t i = 0; i < f.size(); ++i) f[i] = static_cast<float>(i) * 0.5f;
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = static_cast<double>(i) * 0.25;
+  const std::vector<NpzColumn> columns = {{"f", NpyType::f4, f.data(), f.size()},
+                                          {"none", NpyType::f4, f.data(), 0},
+                                          {"d", NpyType::f8, d.data(), d.size()}};
+  {
+    collide::OutputFile out(path("big.npz"));
+    collide::write_npz(out, columns);
+    out.commit();
+  }
+  EXPECT_TRUE(collide::read_file(path("big.npz")) == collide::format_npz(columns));
+}
+
 TEST_F(NpzFileTest, MoveKeepsTheMapping) {
   const SampleColumns s;
   write_text("s.npz", collide::format_npz(s.columns()));

@@ -24,6 +24,7 @@
 // The header is C++17, like the rest of the public API.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -55,6 +56,10 @@ class OutputFile {
   /// socket): it cannot be undone, so write it after everything that can
   /// still fail.
   [[nodiscard]] bool direct() const { return temp_path_.empty(); }
+  /// Writes `bytes` at byte `offset` of a renamed output (!direct()), from
+  /// any thread, for ranges no other call writes; an output written this
+  /// way takes no write(). Throws SceneError on a write error.
+  void write_at(std::uint64_t offset, std::string_view bytes) const;
 
  private:
   void discard() noexcept;
