@@ -191,14 +191,19 @@ COLLIDE_LANE_INLINE void store_interleaved(const V& even, const V& odd, typename
 
 /// sqrt and min of lanes. The kernel body calls these rather than stdx::sqrt
 /// and stdx::min, so that the accurate mode's double-double lanes
-/// (exact_lanes.hpp) can bring their own.
+/// (exact_lanes.hpp) can bring their own. The minimum is a compare and a
+/// select, a when either is NaN, on every lane type: stdx::min is std::min
+/// on the scalar ABI (a NaN first argument is returned) and minps/minpd on
+/// the SIMD ones (the second is), so a NaN K(t) of one contact (an overflow
+/// in its lever arm) gave a NaN friction impulse on one path and mu jn on
+/// the other.
 template <class V>
 COLLIDE_LANE_INLINE V lane_sqrt(const V& x) {
   return stdx::sqrt(x);
 }
 template <class V>
 COLLIDE_LANE_INLINE V lane_min(const V& a, const V& b) {
-  return stdx::min(a, b);
+  return select(b < a, b, a);
 }
 
 /// A 3-vector of lanes.

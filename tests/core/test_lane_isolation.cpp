@@ -23,6 +23,7 @@
 // whole group: the neighbours must not notice.)
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <utility>
@@ -223,6 +224,58 @@ void expect_isolated(bool friction) {
       }
     }
   }
+}
+
+// A body sliding on an immovable ground whose centre is at the largest
+// finite coordinates: the ground's lever arm along the sliding direction
+// overflows, times its zeroed inverse moments that is NaN, and K(t) is NaN.
+// The friction impulse min(|ut| / K(t), mu jn) must then be the same on
+// every path: std::min (the scalar lanes) and minps/minpd (the SIMD lanes)
+// disagreed on which operand a NaN gives (lane_min, lanes.hpp). 37 sliders:
+// four SIMD groups of 8 float lanes and a tail, or of 16 and a tail.
+template <class T>
+void expect_same_bits_with_an_overflowing_ground() {
+  constexpr T big = std::numeric_limits<T>::max();
+  constexpr std::size_t sliders = 37;
+  BodyBuffer<T> start(sliders + 1);
+  ContactBuffer<T> contacts(sliders);
+  BodyRecord<T> ground;
+  ground.m = std::numeric_limits<T>::infinity();
+  ground.I[0] = ground.I[1] = ground.I[2] = std::numeric_limits<T>::infinity();
+  ground.p[0] = big;
+  ground.p[1] = -big;
+  start.set(sliders, ground);
+  for (std::size_t k = 0; k < sliders; ++k) {
+    BodyRecord<T> slider;
+    slider.v[0] = T(0.6);  // sliding along (0.6, 0.8, 0), falling at 2 m/s
+    slider.v[1] = T(0.8);
+    slider.v[2] = T(-2);
+    start.set(k, slider);
+    ContactRecord<T> c;
+    c.a = static_cast<BodyIndex>(k);
+    c.b = static_cast<BodyIndex>(sliders);
+    c.e = T(0.5);
+    c.mu = T(0.5);
+    contacts.set(k, c);
+  }
+  BodyBuffer<T> first = start;
+  const ImpulseBuffer<T> first_j = kernel_solve(first, contacts.view(), options_for(Path::scalar));
+  for (const int threads : {1, 2}) {
+    SCOPED_TRACE("SIMD, threads " + std::to_string(threads));
+    BodyBuffer<T> bodies = start;
+    const ImpulseBuffer<T> j = kernel_solve(bodies, contacts.view(), options_for(Path::simd, threads, 8));
+    for (std::size_t k = 0; k < sliders; ++k) {
+      const BodyRecord<T> x = bodies.record(k), y = first.record(k);
+      EXPECT_EQ(std::memcmp(&x, &y, sizeof(x)), 0) << "body " << k;
+      EXPECT_EQ(std::memcmp(&j.view().j.x[k], &first_j.view().j.x[k], sizeof(T)), 0) << "contact " << k;
+    }
+  }
+  EXPECT_TRUE(std::isnan(first.record(0).v[0]));  // the overflow reached the slider: the case is the one meant
+}
+
+TEST(LaneIsolation, OverflowingGroundGivesTheSameBitsOnEveryPath) {
+  expect_same_bits_with_an_overflowing_ground<float>();
+  expect_same_bits_with_an_overflowing_ground<double>();
 }
 
 TEST(LaneIsolation, FloatFrictionless) { expect_isolated<float>(false); }
