@@ -163,14 +163,20 @@ bool indices_below(const BodyIndex* a, const BodyIndex* b, std::size_t count, Bo
   return bad == 0;
 }
 
+/// The bound indices_below() compares with for `body_count` bodies. With
+/// 2^32 or more bodies it is one too strict for index 2^32 - 1, which the
+/// exact scan in throw_bad_contact then accepts.
+inline BodyIndex index_bound(std::size_t body_count) {
+  return static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
+}
+
 /// Throws (throw_bad_contact) unless every contact of [k, end) has both
-/// indices < body_count and a != b. With 2^32 or more bodies the 32-bit
-/// bound is one too strict for index 2^32 - 1, which the exact scan in
-/// throw_bad_contact then accepts.
+/// indices < body_count and a != b.
 inline void check_indices(const BodyIndex* a, const BodyIndex* b, std::size_t k, std::size_t end,
                           std::size_t body_count) {
-  const auto bound = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
-  if (__builtin_expect(!indices_below(a + k, b + k, end - k, bound), 0)) throw_bad_contact(a, b, k, end, body_count);
+  if (__builtin_expect(!indices_below(a + k, b + k, end - k, index_bound(body_count)), 0)) {
+    throw_bad_contact(a, b, k, end, body_count);
+  }
 }
 
 /// The lowest and highest of level[begin, end), as a loop that vectorises.
@@ -368,7 +374,7 @@ bool one_batch(const ContactView<T>& contacts, std::size_t body_count, const T* 
   const std::size_t n = contacts.count;
   const std::size_t chunks = std::min(chunk_count(n, workers), kMaxClaimChunks);
   if (chunks < 2) return false;
-  const auto bound = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
+  const BodyIndex bound = index_bound(body_count);
   // A first look, on the calling thread, before the body table is touched.
   const std::size_t probe = std::min(n, detail::kRepeatProbe);
   if (!indices_below(contacts.a, contacts.b, probe, bound) ||

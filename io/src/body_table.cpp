@@ -66,11 +66,12 @@ bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) no
   // loops vectorise: x - x == 0 exactly when x is finite.
   const auto finite = [](T x) { return (x - x) == T(0); };
   unsigned bad = 0;
-  for (std::size_t k = 0; k < 4; ++k) {  // m and the moments: > 0 with a finite inverse (inf is allowed)
+  // m and the moments: > 0 with a finite inverse (inf is allowed), that is
+  // x >= the least value with a finite inverse (NaN compares false),
+  // without a division per value.
+  const T least = least_with_finite_inverse<T>();
+  for (std::size_t k = 0; k < 4; ++k) {
     const T* x = columns.column[k];
-    // x >= the least value with a finite inverse: 1/x finite, and x > 0
-    // (NaN compares false), without a division per value.
-    const T least = least_with_finite_inverse<T>();
     for (std::size_t i = i0; i < i1; ++i) bad |= static_cast<unsigned>(!(x[i] >= least));
   }
   for (std::size_t k = 4; k < columns.column.size(); ++k) {
