@@ -286,6 +286,23 @@ def test_partition_islands_is_a_balanced_deterministic_greedy():
         cd.partition_islands([1, 2], 0)
 
 
+def test_single_contact_islands_split_into_the_greedys_ranges():
+    # Every contact an island of its own (independent pairs): the ranges
+    # found in O(partitions) are the ones partition_islands gives.
+    from collide.dask._partition import single_contact_ends
+    for count in (0, 1, 7, 8, 15, 16, 17, 63, 64, 65, 999, 1000, 1001, 4097, 100_003):
+        for p in (1, 2, 3, 5, 8, 13, 64):
+            ends = single_contact_ends(count, p)
+            parts = cd.partition_islands(np.ones(count, dtype=np.uint32), p)
+            if ends is None:
+                # Fewer than eight contacts per partition: left to partition_islands.
+                assert count < 8 * min(p, count)
+                continue
+            counts = np.bincount(parts, minlength=len(ends)) if count else np.zeros(1, dtype=np.int64)
+            np.testing.assert_array_equal(np.diff(ends, prepend=0), counts, err_msg=f"{count} contacts, {p}")
+            np.testing.assert_array_equal(np.repeat(np.arange(len(ends)), counts), parts)
+
+
 def test_stats_partitions_are_balanced(client):
     bodies, contacts = collide.generate("pairs", 10_000, dtype=np.float32)
     solution = cd.solve((bodies, contacts), client, partitions=4)

@@ -31,7 +31,7 @@ import numpy as np
 
 import collide
 
-from ._partition import partition_islands
+from ._partition import partition_islands, single_contact_ends
 from . import _tasks
 
 __all__ = ["GIANT_ISLAND_SHARE", "IslandWarning", "SCENE_COLUMNS", "Solution", "partition_islands", "solve",
@@ -172,6 +172,13 @@ def _partitions(isl, requested, client):
     p = requested if requested is not None else max(1, sum(client.nthreads().values()))
     if int(p) < 1:
         raise ValueError(f"partitions must be >= 1, got {p}")
+    m = len(isl.labels)
+    if isl.count == m and isl.largest <= 1:
+        # Every contact an island of its own, labelled by its row: the
+        # partitions are ranges, found without arrays the length of the scene.
+        ends = single_contact_ends(m, int(p))
+        if ends is not None:
+            return None, np.diff(ends, prepend=np.int64(0)), ends
     island_part = partition_islands(isl.sizes, int(p))
     used = int(island_part.max()) + 1 if len(island_part) else 1
     # Small integers, so that NumPy's stable sort of them is a radix sort.

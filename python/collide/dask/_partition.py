@@ -75,3 +75,26 @@ def partition_islands(sizes, partitions):
         small_parts = np.repeat(np.arange(p, dtype=np.int64), np.diff(firsts, prepend=0, append=len(small)))
         parts[small_ids] = small_parts
     return parts
+
+
+def single_contact_ends(count, partitions):
+    """Where each partition's contacts end when every one of ``count``
+    contacts is an island of its own (independent pairs: the islands'
+    labels are then the contact rows), as :func:`partition_islands` groups
+    them: equal shares of consecutive contacts, found in O(partitions)
+    instead of arrays the length of the scene. None with fewer than eight
+    contacts per partition, where every island counts as a large one and
+    partition_islands deals them round the partitions."""
+    p = max(1, min(int(partitions), count))
+    if count == 0 or p == 1:
+        return np.array([count], dtype=np.int64)
+    target = count / p
+    if 1 > target * LARGE_FRACTION:
+        return None
+    # partition_islands' shares: room ``target`` each, and island i (its
+    # start i) goes to the number of shares ending at or before it, so share
+    # k starts at the first integer not below its running end (searchsorted
+    # of the ends among 0, 1, ..., count - 1).
+    ends = np.cumsum(np.full(p, target))
+    firsts = np.minimum(np.ceil(ends[:p - 1]), count).astype(np.int64)
+    return np.append(firsts, np.int64(count))
