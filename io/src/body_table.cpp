@@ -17,6 +17,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <type_traits>
 #include <utility>
 
 #include <oneapi/tbb/blocked_range.h>
@@ -64,7 +65,7 @@ bool bodies_ok(const BodyColumns<T>& columns, std::size_t i0, std::size_t i1) no
   // The rules of body_ok (collide/rules.hpp), one column at a time and
   // without a branch per value, defects OR-ed into an integer so that the
   // loops vectorise: x - x == 0 exactly when x is finite.
-  const auto finite = [](T x) { return (x - x) == T(0); };
+  const auto finite = [](T x) { return (x - x) == T(0); };  // NOLINT(misc-redundant-expression): NaN for inf, NaN
   unsigned bad = 0;
   // m and the moments: > 0 with a finite inverse (inf is allowed), that is
   // x >= the least value with a finite inverse (NaN compares false),
@@ -166,12 +167,12 @@ BodyTable<T> to_body_table(const BodyView<const T>& bodies) {
   return table;
 }
 
-#define COLLIDE_BODY_TABLE_INSTANTIATE(T)                                               \
-  template struct BodyTable<T>;                                                         \
-  template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                      \
-  template bool bodies_ok<T>(const BodyColumns<T>&, std::size_t, std::size_t) noexcept; \
-  template std::optional<RowDefect> first_body_defect<T>(const BodyColumns<T>&);        \
-  template void inverses_of<T>(const BodyColumns<T>&, T*, const Vec3Array<T>&);         \
+#define COLLIDE_BODY_TABLE_INSTANTIATE(T)                                                          \
+  template struct BodyTable<T>;                                                                    \
+  template BodyBuffer<T> to_body_buffer<T>(const BodyColumns<T>&);                                 \
+  template bool bodies_ok<T>(const BodyColumns<T>&, std::size_t, std::size_t) noexcept;            \
+  template std::optional<RowDefect> first_body_defect<T>(const BodyColumns<T>&);                   \
+  template void inverses_of<T>(const BodyColumns<T>&, std::add_pointer_t<T>, const Vec3Array<T>&); \
   template BodyTable<T> to_body_table<T>(const BodyView<const T>&);
 
 COLLIDE_BODY_TABLE_INSTANTIATE(float)
