@@ -130,8 +130,9 @@ int run_report(int argc, char** argv) {
   if (const auto it = opt.find("seed"); it != opt.end()) config.seed = parse_count("seed", it->second);
   if (const auto it = opt.find("debris-n"); it != opt.end()) {
     config.debris_n = parse_count("debris-n", it->second);
-    if (config.debris_n < 1 || config.debris_n > 0xFFFFFFFFULL)
+    if (config.debris_n < 1 || config.debris_n > 0xFFFFFFFFULL) {
       throw UsageError("--debris-n must be from 1 to 2^32 - 1");
+    }
   } else {
     config.debris_n = std::min(config.n, config.debris_n);
   }

@@ -408,7 +408,9 @@ class IndexPermutation {
 /// for odd i (the cells' x + y is i: boxes two or more apart in the chain
 /// meet at most along an edge, never on a face).
 Vec3 chain_box_centre(std::uint64_t i) {
-  return {static_cast<double>((i + 1) / 2) + 0.5, static_cast<double>(i / 2) + 0.5, 0.5};
+  const std::uint64_t x = (i + 1) / 2;
+  const std::uint64_t y = i / 2;
+  return {static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5, 0.5};
 }
 
 /// Which neighbour of box k the chain's next box is, and so which of the

@@ -112,8 +112,9 @@ class HeaderLiteral {
   /// A quoted string without escapes ('...' or "...").
   std::string_view string(std::string_view what) {
     skip_space();
-    if (pos_ >= text_.size() || (text_[pos_] != '\'' && text_[pos_] != '"'))
+    if (pos_ >= text_.size() || (text_[pos_] != '\'' && text_[pos_] != '"')) {
       fail("expected a quoted " + std::string(what));
+    }
     const char quote = text_[pos_++];
     const std::size_t start = pos_;
     while (pos_ < text_.size() && text_[pos_] != quote) {

@@ -243,7 +243,9 @@ NpzArchive NpzArchive::parse(std::string_view bytes, std::string file_name) {
     if (!is_npy) throw member_error("member " + quoted_member + " is not an .npy array");
     if (!names.insert(name).second) throw member_error("member " + quoted_member + " appears twice in the archive");
     if (const std::string reason = apply_zip64_extra(extra, place); !reason.empty()) {
-      throw member_error("member " + quoted_member + ": " + reason);
+      std::string message = "member " + quoted_member + ": ";
+      message += reason;
+      throw member_error(message);
     }
     if (place.compressed != place.uncompressed) {
       throw member_error("member " + quoted_member + " is stored with " + std::to_string(place.compressed) +

@@ -92,8 +92,9 @@ std::array<const NpzMember*, N> table_members(const NpzArchive& archive, const s
     found[k] = &m;
   }
   for (std::size_t k = 0; k < N; ++k) {
-    if (found[k] == nullptr)
+    if (found[k] == nullptr) {
       member_error(archive, names[k], "missing: the file has no member '" + std::string(names[k]) + ".npy'");
+    }
     if (found[k]->count != found[0]->count) {
       member_error(archive, names[k],
                    std::to_string(found[k]->count) + " rows, but '" + std::string(names[0]) + "' has " +

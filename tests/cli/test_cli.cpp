@@ -313,11 +313,13 @@ void expect_outputs_match_library(const fs::path& bodies, const fs::path& contac
     using Table = collide::BodyTable<T>;
     // Unchanged columns: bit for bit the input values (inf included).
     for (std::size_t k = 0; k < Table::vx; ++k) {
+      // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
       ASSERT_EQ(std::memcmp(&out.column[k][i], &lib.table.column[k][i], sizeof(T)), 0)
           << "body " << i << " column " << collide::kBodyColumns[k];
     }
     const T expected[6] = {v.v.x[i], v.v.y[i], v.v.z[i], v.w.x[i], v.w.y[i], v.w.z[i]};
     for (std::size_t k = 0; k < 6; ++k) {
+      // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
       ASSERT_EQ(std::memcmp(&out.column[Table::vx + k][i], &expected[k], sizeof(T)), 0)
           << "body " << i << " column " << collide::kBodyColumns[Table::vx + k];
     }

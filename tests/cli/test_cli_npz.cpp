@@ -77,6 +77,7 @@ struct SmallScene {
   }
   [[nodiscard]] std::string bodies_bytes() const {
     std::vector<NpzColumn> cols;
+    cols.reserve(17);
     for (int k = 0; k < 17; ++k) cols.push_back({collide::kBodyColumns[k], NpyType::f8, body[k].data(), 2});
     return collide::format_npz(cols);
   }

@@ -62,7 +62,7 @@ std::vector<T> draw(std::uint64_t seed, int range, std::size_t n = kCount) {
 
 template <class T>
 bool same_bits(T a, T b) {
-  return std::memcmp(&a, &b, sizeof a) == 0;
+  return std::memcmp(&a, &b, sizeof a) == 0;  // NOLINT(bugprone-suspicious-memory-comparison): the bits are the point
 }
 
 /// Runs f on lanes V over whole blocks of the inputs: f(in..., out...) with

@@ -266,7 +266,9 @@ void expect_same_bits_with_an_overflowing_ground() {
     const ImpulseBuffer<T> j = kernel_solve(bodies, contacts.view(), options_for(Path::simd, threads, 8));
     for (std::size_t k = 0; k < sliders; ++k) {
       const BodyRecord<T> x = bodies.record(k), y = first.record(k);
+      // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
       EXPECT_EQ(std::memcmp(&x, &y, sizeof(x)), 0) << "body " << k;
+      // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
       EXPECT_EQ(std::memcmp(&j.view().j.x[k], &first_j.view().j.x[k], sizeof(T)), 0) << "contact " << k;
     }
   }

@@ -222,7 +222,7 @@ Outputs<V> evaluate(const std::vector<Inputs<typename V::value_type>>& in) {
 
 template <class T>
 void expect_vector_helpers() {
-  const std::size_t n = 8 * 500;
+  const std::size_t n = std::size_t{8} * 500;
   const auto in = random_inputs<T>(n);
   const Outputs<d::ScalarLanes<T>> s = evaluate<d::ScalarLanes<T>>(in);
   const Outputs<d::SimdLanes<T>> v = evaluate<d::SimdLanes<T>>(in);

@@ -231,8 +231,9 @@ Scene<float> grouped_by_level(Scene<float> scene) {
   Scene<float> out;
   out.bodies = scene.bodies;
   out.contacts.resize(scene.contacts.size());
-  for (std::size_t i = 0; i < scene.contacts.size(); ++i)
+  for (std::size_t i = 0; i < scene.contacts.size(); ++i) {
     out.contacts.set(i, scene.contacts.record(schedule.order()[i]));
+  }
   return out;
 }
 

@@ -110,7 +110,7 @@ class FakeSysfs {
   std::filesystem::path dir_;
 };
 
-constexpr std::size_t kKiB = 1024, kMiB = 1024 * 1024;
+constexpr std::size_t kKiB = 1024, kMiB = std::size_t{1024} * 1024;
 
 /// A probe that knows nothing: no /sys directory, no sysconf, no CPUID.
 MachineProbe empty_probe(const FakeSysfs& sysfs) {
@@ -187,7 +187,7 @@ TEST(Bandwidth, TriadArraysStayWithinMemory) {
   EXPECT_EQ(default_triad_array_bytes(p), 32 * kMiB);
   // Memory unknown: no cap.
   p.physical_memory_bytes = nullptr;
-  EXPECT_EQ(default_triad_array_bytes(p), 4 * 508 * kMiB);
+  EXPECT_EQ(default_triad_array_bytes(p), std::size_t{4} * 508 * kMiB);
   // A real L3 on a big machine: 4 x L3, above the 128 MiB floor.
   p.sysconf_cache_bytes = [](int level) -> long { return level == 3 ? long{64 * kMiB} : -1L; };
   p.physical_memory_bytes = []() -> std::optional<std::size_t> { return std::size_t{256} << 30; };

@@ -76,8 +76,9 @@ void write_fixture(const std::filesystem::path& dir, const SceneRecords<float>& 
   std::string bodies(collide::bodies_header());
   for (const auto& b : scene.bodies) collide::append_body_row<double>(bodies, collide::detail::narrow<double>(b));
   std::string contacts(collide::contacts_header());
-  for (const auto& c : scene.contacts)
+  for (const auto& c : scene.contacts) {
     collide::append_contact_row<double>(contacts, collide::detail::narrow<double>(c));
+  }
   write_text((dir / "bodies.csv").string(), bodies);
   write_text((dir / "contacts.csv").string(), contacts);
 

@@ -382,8 +382,10 @@ TEST(HardAccurate, CliOnCallersValuesOffUnit) {
     using T = decltype(zero);
     for (const auto& [family, records] : off_unit_families<T>(fit)) {
       const std::string precision = test::type_name<T>();
-      SCOPED_TRACE(family + " " + precision + " " + to_string(fit));
-      const fs::path dir = fs::path(COLLIDE_TEST_TMP) / ("off-unit-" + family + "-" + precision + "-" + to_string(fit));
+      SCOPED_TRACE(std::string(family).append(" ").append(precision).append(" ").append(to_string(fit)));
+      const fs::path dir =
+          fs::path(COLLIDE_TEST_TMP) /
+          std::string("off-unit-").append(family).append("-").append(precision).append("-").append(to_string(fit));
       fs::create_directories(dir);
       BodyTable<T> table;
       for (const BodyRecord<T>& b : records.bodies) table.push_back(b);

@@ -542,7 +542,9 @@ void expect_approaching_in_double(const collide::Scene<T>& scene, double margin)
 /// The centre of box i of the chain before its draws: cell ((i + 1) / 2,
 /// i / 2, 0) + 0.5, written out here so the test does not share the code.
 std::array<double, 3> staircase_centre(std::uint64_t i) {
-  return {static_cast<double>((i + 1) / 2) + 0.5, static_cast<double>(i / 2) + 0.5, 0.5};
+  const std::uint64_t x = (i + 1) / 2;
+  const std::uint64_t y = i / 2;
+  return {static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5, 0.5};
 }
 
 /// The velocity of box i before its jitter: (0.5, -0.5, 0) for even i, its

@@ -244,13 +244,16 @@ TEST(SceneIo, FastAndCarefulPathsAgree) {
   const auto fast_d = collide::parse_bodies<double>(bodies, "b");
   const auto slow_d = collide::parse_bodies<double>(with_blanks(bodies), "b");
   for (std::size_t k = 0; k < 17; ++k) {
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
     EXPECT_EQ(std::memcmp(fast_f.column[k].data(), slow_f.column[k].data(), 4000 * sizeof(float)), 0);
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
     EXPECT_EQ(std::memcmp(fast_d.column[k].data(), slow_d.column[k].data(), 4000 * sizeof(double)), 0);
   }
   const auto fast_c = collide::parse_contacts<float>(contacts, "c", 4000);
   const auto slow_c = collide::parse_contacts<float>(with_blanks(contacts), "c", 4000);
   for (std::size_t k = 0; k < 2000; ++k) {
     const auto x = fast_c.record(k), y = slow_c.record(k);
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): the bits are the point
     EXPECT_EQ(std::memcmp(&x, &y, sizeof x), 0) << k;
   }
 }

@@ -37,7 +37,7 @@ class SceneNpzTest : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   [[nodiscard]] std::string put(const std::string& name, const std::vector<NpzColumn>& columns) const {
-    const std::string p = (dir_ / name).string();
+    std::string p = (dir_ / name).string();
     std::ofstream(p, std::ios::binary) << collide::format_npz(columns);
     return p;
   }

@@ -29,11 +29,16 @@
 
 extern "C" {
 
+// The ITT API fixes these reserved names: the loader finds them by name.
+// NOLINTBEGIN(bugprone-reserved-identifier)
+
 // Presence marks an ITT "version 1" collector, whose functions the loader
 // looks up by name.
 __attribute__((visibility("default"))) int __itt_api_version = 1;
 
 __attribute__((visibility("default"))) void __itt_sync_releasing(void* addr) { __tsan_release(addr); }
 __attribute__((visibility("default"))) void __itt_sync_acquired(void* addr) { __tsan_acquire(addr); }
+
+// NOLINTEND(bugprone-reserved-identifier)
 
 }  // extern "C"

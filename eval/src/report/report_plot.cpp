@@ -217,8 +217,16 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
     const std::string file = gp_string((tmp / (std::string(family) + ".dat")).string());
     const std::string c = colour.at(family);
     if (!plot1.empty()) plot1 += ", \\\n  ";
-    plot1 += file + " using 1:2 with points pt 7 ps 1.4 lc rgb '" + c + "' title '" + family + "', \\\n  " + file +
-             " using 1:2:3 with labels left offset 0.8,0 font ',8' tc rgb '" + c + "' notitle";
+    plot1.append(file)
+        .append(" using 1:2 with points pt 7 ps 1.4 lc rgb '")
+        .append(c)
+        .append("' title '")
+        .append(family)
+        .append("', \\\n  ")
+        .append(file)
+        .append(" using 1:2:3 with labels left offset 0.8,0 font ',8' tc rgb '")
+        .append(c)
+        .append("' notitle");
   }
   gp << "plot " << plot1 << "\n";
 
@@ -247,11 +255,26 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
     const std::string c = model_colour.count(name) ? model_colour.at(name) : "#000000";
     const std::string file = gp_string((tmp / ("sweep-" + name + ".dat")).string());
     if (!plot2.empty()) plot2 += ", \\\n  ";
-    plot2 += file + " using 1:2 with linespoints pt 7 lw 2 lc rgb '" + c + "' title '" + name + " (" +
-             format("%.0f", bytes) + " B/collision)'";
+    plot2.append(file)
+        .append(" using 1:2 with linespoints pt 7 lw 2 lc rgb '")
+        .append(c)
+        .append("' title '")
+        .append(name)
+        .append(" (")
+        .append(format("%.0f", bytes))
+        .append(" B/collision)'");
     if (bound > 0) {
-      plot2 += ", " + format("%.6e", bound) + " with lines dt 2 lw 2 lc rgb '" + c + "' title '" + name +
-               " bandwidth bound (triad " + format("%.1f", triad / 1e9) + " GB/s / " + format("%.0f", bytes) + " B)'";
+      plot2.append(", ")
+          .append(format("%.6e", bound))
+          .append(" with lines dt 2 lw 2 lc rgb '")
+          .append(c)
+          .append("' title '")
+          .append(name)
+          .append(" bandwidth bound (triad ")
+          .append(format("%.1f", triad / 1e9))
+          .append(" GB/s / ")
+          .append(format("%.0f", bytes))
+          .append(" B)'");
     }
     // Where the working set fills the L2 of the threads and the shared L3.
     const double l2 = static_cast<double>(report.machine.l2_bytes.value_or(0)) * max_threads / bytes;
@@ -260,8 +283,9 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
       if (n <= 0) continue;
       gp << "set arrow " << arrow++ << " from " << format("%.4e", n) << ", graph 0 to " << format("%.4e", n)
          << ", graph 1 nohead dt 3 lw 1.5 lc rgb '" << c << "'\n";
-      gp << "set label " << arrow << " " << gp_string(what + " full (" + name + ")") << " at " << format("%.4e", n)
-         << ", graph 0.98 rotate by 90 right offset -0.7,0 font ',8' tc rgb '" << c << "'\n";
+      gp << "set label " << arrow << " " << gp_string(std::string(what).append(" full (").append(name).append(")"))
+         << " at " << format("%.4e", n) << ", graph 0.98 rotate by 90 right offset -0.7,0 font ',8' tc rgb '" << c
+         << "'\n";
     }
   }
   if (y_max > 0 && std::isfinite(y_min)) {
