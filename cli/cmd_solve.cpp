@@ -132,9 +132,11 @@ struct SolveRequest {
 template <class T>
 int solve_scene(const SolveRequest& req) {
   const auto t_read = Clock::now();
-  const LoadedBodies<T> table = load_bodies<T>(req.bodies_path, req.bodies_format);
+  // The bodies' rules are checked in the pass that fills the solve's arrays
+  // (one read of the file), before the contacts file is read.
+  const LoadedBodies<T> table = load_bodies<T>(req.bodies_path, req.bodies_format, BodyRules::by_caller);
+  SolveBodies<T> bodies(table);
   const LoadedContacts<T> contacts = load_contacts<T>(req.contacts_path, req.contacts_format, table.size());
-  SolveBodies<T> bodies(table.columns());
   const double read_seconds = seconds_since(t_read);
 
   // The reference must see the inputs the kernel sees: copy before solving.

@@ -249,11 +249,21 @@ NpyType npz_scene_precision(const NpzArchive& archive) {
 }
 
 template <class T>
-LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
+void LoadedBodies<T>::check() const {
+  if (checked_) return;
+  if (const std::optional<RowDefect> bad = first_body_defect(columns_)) {
+    throw SceneError(archive_ ? archive_->file_name() : std::string(), 0, bad->row, std::string(bad->defect.column),
+                     bad->defect.reason);
+  }
+}
+
+template <class T>
+LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRules rules) {
   LoadedBodies<T> out;
   if (format == SceneFormat::csv) {
-    out.table_ = read_bodies<T>(path);
+    out.table_ = read_bodies<T>(path);  // every row checked as it is parsed
     out.columns_ = columns_of(out.table_);
+    out.checked_ = true;
     return out;
   }
   out.archive_ = std::make_unique<NpzArchive>(NpzArchive::map(path));
@@ -267,8 +277,9 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format) {
     out.columns_.column[k] = real_column<T>(archive, *members[k], precision, out.table_.column[k], in_place);
     out.mapped_ |= in_place;
   }
-  if (const std::optional<RowDefect> bad = first_body_defect(out.columns_)) {
-    throw SceneError(archive.file_name(), 0, bad->row, std::string(bad->defect.column), bad->defect.reason);
+  if (rules == BodyRules::checked) {
+    out.check();
+    out.checked_ = true;
   }
   return out;
 }
@@ -305,6 +316,15 @@ SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
       std::memcpy(solved[k] + r.begin(), columns.column[11 + k] + r.begin(), r.size() * sizeof(T));
     }
   });
+}
+
+template <class T>
+SolveBodies<T>::SolveBodies(const LoadedBodies<T>& loaded)
+    : count_(loaded.size()), own_(allocate_large<T>(10 * loaded.size())) {
+  const BodyColumns<T>& columns = loaded.columns();
+  for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
+  BodyView<T> v = view();
+  if (!screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w)) loaded.check();
 }
 
 template <class T>
@@ -474,7 +494,7 @@ void write_contacts(OutputFile& out, SceneFormat format, const ContactView<T>& c
   template class LoadedBodies<T>;                                                                  \
   template class LoadedContacts<T>;                                                                \
   template class SolveBodies<T>;                                                                   \
-  template LoadedBodies<T> load_bodies<T>(const std::string&, SceneFormat);                        \
+  template LoadedBodies<T> load_bodies<T>(const std::string&, SceneFormat, BodyRules);             \
   template LoadedContacts<T> load_contacts<T>(const std::string&, SceneFormat, std::size_t);       \
   template void write_bodies_npz<T>(OutputFile&, const BodyColumns<T>&, const BodyView<const T>&); \
   template void write_impulses_npz<T>(OutputFile&, const ImpulseView<const T>&);                   \

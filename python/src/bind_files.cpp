@@ -102,7 +102,25 @@ py::tuple load_t(const std::string& bodies_path, const std::string& contacts_pat
   std::shared_ptr<LoadedContacts<T>> lc;
   {
     py::gil_scoped_release release;
-    lb = std::make_shared<LoadedBodies<T>>(load_bodies<T>(bodies_path, scene_format_of(bodies_path)));
+    lb = std::make_shared<LoadedBodies<T>>(
+        load_bodies<T>(bodies_path, scene_format_of(bodies_path), BodyRules::by_caller));
+  }
+  // The arrays the solver takes and writes: the inverses, and v and w
+  // copied, since a solve writes them; q and p stay in the file. Filled in
+  // the pass that checks the bodies' rules (one read of the file), before
+  // the contacts file is read.
+  const BodyColumns<T>& bc = lb->columns();
+  const std::size_t n = bc.count;
+  const auto rows = static_cast<py::ssize_t>(n);
+  py::array inv_mass = new_array(d, {rows});
+  py::array inv_inertia = new_array(d, {3, rows});
+  py::array vel = new_array(d, {3, rows});
+  py::array ang = new_array(d, {3, rows});
+  {
+    py::gil_scoped_release release;
+    if (!screened_solve_arrays(bc, data<T>(inv_mass), vec3<T>(inv_inertia), vec3<T>(vel), vec3<T>(ang))) {
+      lb->check();
+    }
     lc = std::make_shared<LoadedContacts<T>>(
         load_contacts<T>(contacts_path, scene_format_of(contacts_path), lb->size()));
   }
@@ -113,17 +131,11 @@ py::tuple load_t(const std::string& bodies_path, const std::string& contacts_pat
   const py::object cfile = file_object(lc, contacts_path, lc->mapped_bytes());
   const py::dtype dt = numpy_dtype(d);
 
-  const BodyColumns<T>& bc = lb->columns();
-  const std::size_t n = bc.count;
-  // The inverses the solver takes are computed; q and p stay in the file;
-  // v and w are copied, since a solve writes them.
-  const auto [inv_mass, inv_inertia] = inverse_arrays(bc, d);
   const auto cols = [&bc](std::size_t first, std::size_t count) {
     return std::vector<const T*>(bc.column.begin() + first, bc.column.begin() + first + count);
   };
-  const auto copy = [&](std::size_t first) { return copy_rows<T>(dt, bc.column.data() + first, 3, n); };
   py::object bodies = py::cast(Bodies(inv_mass, inv_inertia, columns_array<T>(dt, cols(4, 4), n, bfile),
-                                      columns_array<T>(dt, cols(8, 3), n, bfile), copy(11), copy(14)));
+                                      columns_array<T>(dt, cols(8, 3), n, bfile), vel, ang));
 
   const ContactView<T>& v = lc->view();
   const std::size_t m = v.count;

@@ -2,6 +2,7 @@
 // columns used in place, conversions between precisions and id dtypes, and
 // every refusal naming the file, the member (column) and the row.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -20,10 +21,12 @@
 #include "collide/validate.hpp"
 
 namespace fs = std::filesystem;
+using collide::BodyRules;
 using collide::NpyType;
 using collide::NpzColumn;
 using collide::SceneError;
 using collide::SceneFormat;
+using collide::SolveBodies;
 
 namespace {
 
@@ -161,6 +164,48 @@ TEST_F(SceneNpzTest, RulesAreTheCsvRules) {
   const SceneError ce = scene_error([&] { (void)collide::load_contacts<double>(cp, SceneFormat::npz, 4); });
   EXPECT_EQ(ce.row(), 1u);
   EXPECT_EQ(ce.column(), "e");
+}
+
+TEST_F(SceneNpzTest, SolveArraysCheckTheRulesInTheirOnePass) {
+  // Many chunks of the fused pass (8192 bodies each), an immovable body and
+  // varied values: the arrays are bit for bit those of the separate passes.
+  constexpr std::size_t kN = 70001;
+  Bodies<float> b(kN);
+  for (std::size_t i = 0; i < kN; ++i) {
+    b.col[1][i] = 0.5f + static_cast<float>(i % 7);
+    b.col[14][i] = -static_cast<float>(i) / 3.0f;
+  }
+  b.col[0][12345] = b.col[2][12345] = std::numeric_limits<float>::infinity();
+  const auto loaded = collide::load_bodies<float>(put("b.npz", b.columns()), SceneFormat::npz, BodyRules::by_caller);
+  const SolveBodies<float> fused(loaded);
+  const SolveBodies<float> apart(loaded.columns());
+  const auto x = fused.view(), y = apart.view();
+  const auto same = [&](const float* p, const float* q, const char* what) {
+    for (std::size_t i = 0; i < kN; ++i) {
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(p[i]), std::bit_cast<std::uint32_t>(q[i])) << what << " " << i;
+    }
+  };
+  same(x.inv_mass, y.inv_mass, "inv_mass");
+  same(x.inv_inertia.x, y.inv_inertia.x, "1/Ix");
+  same(x.inv_inertia.y, y.inv_inertia.y, "1/Iy");
+  same(x.v.x, y.v.x, "vx");
+  same(x.w.y, y.w.y, "wy");
+  EXPECT_EQ(x.inv_mass[12345], 0.0f);
+
+  // Two bad bodies in different chunks: the first row is named, as
+  // load_bodies names it, whichever chunk a thread screened first.
+  b.col[5][60000] = std::numeric_limits<float>::quiet_NaN();  // qx
+  b.col[0][20001] = -1.0f;                                    // m
+  const std::string p = put("bad.npz", b.columns());
+  const auto unchecked = collide::load_bodies<float>(p, SceneFormat::npz, BodyRules::by_caller);
+  const SceneError e = scene_error([&] { const SolveBodies<float> s(unchecked); });
+  EXPECT_EQ(e.file(), p);
+  EXPECT_EQ(e.row(), 20001u);
+  EXPECT_EQ(e.column(), "m");
+  const SceneError checked = scene_error([&] { (void)collide::load_bodies<float>(p, SceneFormat::npz); });
+  EXPECT_EQ(std::string(checked.what()), std::string(e.what()));
+  const SceneError later = scene_error([&] { unchecked.check(); });
+  EXPECT_EQ(std::string(later.what()), std::string(e.what()));
 }
 
 TEST_F(SceneNpzTest, SixtyFourBitIdsAsNumPyWritesThem) {

@@ -190,6 +190,14 @@ BodyBuffer<T> to_body_buffer(const BodyTable<T>& table) {
 /// parallel. No rule is checked (to_body_buffer checks them).
 template <class T>
 void inverses_of(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>& inv_inertia);
+/// The arrays a solve of `columns` writes, and the rules, in one read of the
+/// columns: chunk by chunk, bodies_ok's verdict and, while the chunk is in
+/// cache, 1/m and 1/I as inverses_of stores them and v, w copied. False when
+/// some body breaks a rule: the outputs are then unspecified, and
+/// first_body_defect names the body. Rows in parallel.
+template <class T>
+bool screened_solve_arrays(const BodyColumns<T>& columns, T* inv_mass, const Vec3Array<T>& inv_inertia,
+                           const Vec3Array<T>& v, const Vec3Array<T>& w);
 /// The other way: a kernel view in physical units (1/x, inf for 0), what
 /// write_body_table writes as a scene file.
 template <class T>

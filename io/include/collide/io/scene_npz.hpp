@@ -65,12 +65,22 @@ std::string_view to_string(SceneFormat format);
 /// (SceneError if they disagree, or if it has none).
 NpyType npz_scene_precision(const NpzArchive& archive);
 
+/// Whether load_bodies checks the rules of every body (`checked`), or leaves
+/// that to its caller (`by_caller`), who must call LoadedBodies::check(), or
+/// SolveBodies' checking constructor, before using a value: a caller that
+/// reads every column anyway checks them in the same pass
+/// (screened_solve_arrays). A CSV file is checked as it is parsed either way.
+enum class BodyRules { checked, by_caller };
+
 /// A bodies file of either format, loaded for a solve in precision T: its
 /// seventeen columns (columns()), in the mapping where they can stay there.
 /// Movable, not copyable; columns() dies with it.
 template <class T>
 class LoadedBodies {
  public:
+  /// Throws the SceneError of the first body that breaks a rule (the file,
+  /// the row, the column and the reason); returns when none does.
+  void check() const;
   [[nodiscard]] const BodyColumns<T>& columns() const { return columns_; }
   [[nodiscard]] std::size_t size() const { return columns_.count; }
   /// True when at least one column is used in place, in the file's mapping.
@@ -80,11 +90,12 @@ class LoadedBodies {
 
  private:
   template <class U>
-  friend LoadedBodies<U> load_bodies(const std::string& path, SceneFormat format);
+  friend LoadedBodies<U> load_bodies(const std::string& path, SceneFormat format, BodyRules rules);
   BodyTable<T> table_;                   // CSV rows, or converted binary columns
   std::unique_ptr<NpzArchive> archive_;  // binary: the mapped file
   BodyColumns<T> columns_;
   bool mapped_ = false;
+  bool checked_ = false;  // every body known to obey the rules
 };
 
 /// A contacts file of either format, loaded for a solve in precision T; its
@@ -120,6 +131,11 @@ template <class T>
 class SolveBodies {
  public:
   explicit SolveBodies(const BodyColumns<T>& columns);
+  /// The same from a loaded file, checking its rules in the pass that fills
+  /// the arrays (screened_solve_arrays) where load_bodies left them to the
+  /// caller: the SceneError of LoadedBodies::check() for a body that breaks
+  /// one.
+  explicit SolveBodies(const LoadedBodies<T>& loaded);
   /// For the solver: q and p must not be written through it (the kernels
   /// only read them; a mapped file's pages are read-only).
   [[nodiscard]] BodyView<T> view();
@@ -135,9 +151,10 @@ class SolveBodies {
   std::array<const T*, 7> read_{};  // qw, qx, qy, qz, px, py, pz
 };
 
-/// Reads a bodies file (CSV: read_bodies; binary: mapped and checked).
+/// Reads a bodies file (CSV: read_bodies; binary: mapped, and checked
+/// unless `rules` leaves that to the caller).
 template <class T>
-LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format);
+LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRules rules = BodyRules::checked);
 /// Reads a contacts file whose ids refer to `body_count` bodies.
 template <class T>
 LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std::size_t body_count);
