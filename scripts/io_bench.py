@@ -11,9 +11,12 @@ converted to CSV (`collide convert`). Then, --runs times, alternated:
     takes seconds), each after removing the previous outputs and `sync`, so
     that every run writes new files and pays for nothing earlier;
   * `cat` of the binary run's four files (inputs and outputs) to /dev/null,
-    page cache warm: the cost of moving the same bytes through a process;
-    and `cat` of its two outputs into a new file: what writing those bytes
-    into new page-cache pages costs on this machine, whoever writes them;
+    page cache warm, and of its two inputs alone; and `cat` of its two
+    outputs into a new file: what writing those bytes into new page-cache
+    pages costs on this machine, whoever writes them. collide's read and
+    write are compared with both: cat of all four files to /dev/null, and
+    cat moving the same bytes the way the solve does (the inputs read, the
+    outputs written into new files);
 and then --loads calls of `collide.load` of the binary scene in a row in this
 process, checking that the arrays it returns are views of the files'
 mappings, not copies.
@@ -103,11 +106,13 @@ def main():
                  os.path.join(tmp, f"{table}.csv")])
         print(f"{args.n:,} pairs, float, written as .npz and .csv in {time.perf_counter() - t:.1f} s", flush=True)
 
-        npz, csv, cat, cat_write, load = [], [], [], [], []
+        npz, csv, cat, cat_read, cat_write, load = [], [], [], [], [], []
         for r in range(args.runs):
             stats, outs = solve(collide_bin, tmp, "npz", args.threads)
             npz.append(stats)
-            cat.append(timed_cat([os.path.join(tmp, "bodies.npz"), os.path.join(tmp, "contacts.npz"), *outs]))
+            inputs = [os.path.join(tmp, "bodies.npz"), os.path.join(tmp, "contacts.npz")]
+            cat.append(timed_cat([*inputs, *outs]))
+            cat_read.append(timed_cat(inputs))
             copy = os.path.join(tmp, "copy")
             os.sync()
             t = time.perf_counter()
@@ -144,6 +149,7 @@ def main():
         row("binary io_fraction", [s["io_fraction"] for s in npz], unit="")
         row("CSV read + write", [io(s) for s in csv])
         row("cat of the four binary files to /dev/null", cat)
+        row("cat of the two inputs to /dev/null", cat_read)
         row("cat of the two outputs into a new file", cat_write)
         row("collide.load (Python, views of the mapping)", load, unit="ms", scale=1000)
         best_npz = min(io(s) for s in npz)
@@ -151,6 +157,8 @@ def main():
         print(f"  CSV I/O / binary I/O      {min(io(s) for s in csv) / best_npz:6.1f}x   [>= 30x]")
         print(f"  binary I/O / cat          {best_npz / min(cat):6.2f}x   [<= 3x]  (writing the outputs' bytes into a new "
               f"file alone, by cat: {min(cat_write) / min(cat):.2f}x)")
+        print(f"  binary I/O / cat moving the same bytes (inputs read to /dev/null, outputs written into a new file) "
+              f"{best_npz / (min(cat_read) + min(cat_write)):.2f}x")
         print(f"  binary io_fraction        {min(s['io_fraction'] for s in npz):6.3f}    [< 0.9]")
         print(f"  collide.load              {min(load) * 1000:6.1f} ms  [< 50 ms at 4M contacts]")
 
