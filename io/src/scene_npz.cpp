@@ -304,27 +304,27 @@ T* allocate_large(std::size_t n) {
 }  // namespace
 
 template <class T>
-SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
-    : count_(columns.count), own_(allocate_large<T>(10 * columns.count)) {
+bool SolveBodies<T>::fill(const BodyColumns<T>& columns) {
   for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
   BodyView<T> v = view();
-  inverses_of(columns, v.inv_mass, v.inv_inertia);
-  T* const solved[6] = {v.v.x, v.v.y, v.v.z, v.w.x, v.w.y, v.w.z};
-  using Range = oneapi::tbb::blocked_range<std::size_t>;
-  oneapi::tbb::parallel_for(Range(0, count_, std::size_t{1} << 16), [&](const Range& r) {
-    for (std::size_t k = 0; k < 6; ++k) {
-      std::memcpy(solved[k] + r.begin(), columns.column[11 + k] + r.begin(), r.size() * sizeof(T));
-    }
-  });
+  return screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w);
+}
+
+template <class T>
+SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
+    : count_(columns.count), own_(allocate_large<T>(10 * columns.count)) {
+  if (!fill(columns)) {
+    const std::optional<RowDefect> bad = first_body_defect(columns);
+    throw std::invalid_argument("SolveBodies: row " + std::to_string(bad ? bad->row : 0) + ", column '" +
+                                std::string(bad ? bad->defect.column : "?") +
+                                "': " + (bad ? bad->defect.reason : std::string("breaks a rule")));
+  }
 }
 
 template <class T>
 SolveBodies<T>::SolveBodies(const LoadedBodies<T>& loaded)
     : count_(loaded.size()), own_(allocate_large<T>(10 * loaded.size())) {
-  const BodyColumns<T>& columns = loaded.columns();
-  for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
-  BodyView<T> v = view();
-  if (!screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w)) loaded.check();
+  if (!fill(loaded.columns())) loaded.check();
 }
 
 template <class T>

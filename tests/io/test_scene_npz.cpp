@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -178,19 +179,24 @@ TEST_F(SceneNpzTest, SolveArraysCheckTheRulesInTheirOnePass) {
   b.col[0][12345] = b.col[2][12345] = std::numeric_limits<float>::infinity();
   const auto loaded = collide::load_bodies<float>(put("b.npz", b.columns()), SceneFormat::npz, BodyRules::by_caller);
   const SolveBodies<float> fused(loaded);
-  const SolveBodies<float> apart(loaded.columns());
-  const auto x = fused.view(), y = apart.view();
+  std::vector<float> inverses(4 * kN);
+  collide::inverses_of(
+      loaded.columns(), inverses.data(),
+      collide::Vec3Array<float>{inverses.data() + kN, inverses.data() + 2 * kN, inverses.data() + 3 * kN});
+  const auto x = fused.view();
   const auto same = [&](const float* p, const float* q, const char* what) {
     for (std::size_t i = 0; i < kN; ++i) {
       ASSERT_EQ(std::bit_cast<std::uint32_t>(p[i]), std::bit_cast<std::uint32_t>(q[i])) << what << " " << i;
     }
   };
-  same(x.inv_mass, y.inv_mass, "inv_mass");
-  same(x.inv_inertia.x, y.inv_inertia.x, "1/Ix");
-  same(x.inv_inertia.y, y.inv_inertia.y, "1/Iy");
-  same(x.v.x, y.v.x, "vx");
-  same(x.w.y, y.w.y, "wy");
+  same(x.inv_mass, inverses.data(), "inv_mass");
+  same(x.inv_inertia.x, inverses.data() + kN, "1/Ix");
+  same(x.inv_inertia.y, inverses.data() + 2 * kN, "1/Iy");
+  same(x.inv_inertia.z, inverses.data() + 3 * kN, "1/Iz");
+  same(x.v.x, b.col[11].data(), "vx");
+  same(x.w.z, b.col[16].data(), "wz");
   EXPECT_EQ(x.inv_mass[12345], 0.0f);
+  EXPECT_EQ(x.q.w, loaded.columns().column[4]) << "q in place";
 
   // Two bad bodies in different chunks: the first row is named, as
   // load_bodies names it, whichever chunk a thread screened first.
@@ -206,6 +212,13 @@ TEST_F(SceneNpzTest, SolveArraysCheckTheRulesInTheirOnePass) {
   EXPECT_EQ(std::string(checked.what()), std::string(e.what()));
   const SceneError later = scene_error([&] { unchecked.check(); });
   EXPECT_EQ(std::string(later.what()), std::string(e.what()));
+  // Columns of no file: the first bad row, as an invalid argument.
+  try {
+    const SolveBodies<float> s(unchecked.columns());
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& x) {
+    EXPECT_NE(std::string(x.what()).find("row 20001, column 'm'"), std::string::npos) << x.what();
+  }
 }
 
 TEST_F(SceneNpzTest, SixtyFourBitIdsAsNumPyWritesThem) {

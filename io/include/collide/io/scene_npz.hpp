@@ -120,16 +120,18 @@ class LoadedContacts {
   bool mapped_ = false;
 };
 
-/// The bodies of a solve over columns that obey the rules (a loaded
-/// file's): q and p are read where the columns hold them (a mapped file's
-/// pages, a table) and never copied; 1/m and 1/I (inverses_of) and v and w,
-/// which the solve writes, live in arrays of its own, allocated without
-/// being cleared first, in 2 MiB pages where the system gives them (first
-/// touch faults once per 2 MiB; docs/decisions/0002-binary-scene-files.md).
-/// view() is valid while the columns are. Not copyable; movable.
+/// The bodies of a solve over columns in physical units (a loaded file's):
+/// q and p are read where the columns hold them (a mapped file's pages, a
+/// table) and never copied; 1/m and 1/I (inverses_of) and v and w, which the
+/// solve writes, live in arrays of its own, allocated without being cleared
+/// first, in 2 MiB pages where the system gives them (first touch faults
+/// once per 2 MiB; docs/decisions/0002-binary-scene-files.md), and filled
+/// in the pass that checks the rules (screened_solve_arrays). view() is
+/// valid while the columns are. Not copyable; movable.
 template <class T>
 class SolveBodies {
  public:
+  /// std::invalid_argument naming the first row that breaks a rule.
   explicit SolveBodies(const BodyColumns<T>& columns);
   /// The same from a loaded file, checking its rules in the pass that fills
   /// the arrays (screened_solve_arrays) where load_bodies left them to the
@@ -143,6 +145,8 @@ class SolveBodies {
   [[nodiscard]] std::size_t size() const { return count_; }
 
  private:
+  /// q and p pointed at, the arrays filled; false when a body breaks a rule.
+  bool fill(const BodyColumns<T>& columns);
   std::size_t count_ = 0;
   struct Free {
     void operator()(T* p) const noexcept;
