@@ -582,15 +582,34 @@ COLLIDE_LANE_INLINE ContactResult<V> evaluate_law_accurately(BodyLanes<M, V>& a,
   return ContactResult<V>{narrow<V>(r.j)};
 }
 
+/// The law's outputs, the new velocities and J, with every NaN made the
+/// one NaN (canonical_nan in lanes.hpp): what every path writes.
+template <class M, class V>
+COLLIDE_LANE_INLINE void canonical_outputs(BodyLanes<M, V>& a, BodyLanes<M, V>& b, Vec3<V>& j) {
+  const auto each = [](Vec3<V>& x) COLLIDE_LANE_LAMBDA {
+    x = {canonical_nan(x.x), canonical_nan(x.y), canonical_nan(x.z)};
+  };
+  each(a.v);
+  each(b.v);
+  if constexpr (kRotates<M>) {
+    each(a.w);
+    each(b.w);
+  }
+  each(j);
+}
+
 /// The law for W contacts in the mode `Mode` (FastMode or AccurateMode).
 template <class M, class V, bool kFriction, class Mode = FastMode>
 COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                       const ContactLanes<V>& contact) {
+  ContactResult<V> r;
   if constexpr (std::is_same_v<Mode, AccurateMode>) {
-    return evaluate_law_accurately<M, V, kFriction>(a, b, contact);
+    r = evaluate_law_accurately<M, V, kFriction>(a, b, contact);
   } else {
-    return evaluate_law<M, V, kFriction, FastMode>(a, b, contact);
+    r = evaluate_law<M, V, kFriction, FastMode>(a, b, contact);
   }
+  canonical_outputs(a, b, r.j);
+  return r;
 }
 
 }  // namespace COLLIDE_KERNEL_NS

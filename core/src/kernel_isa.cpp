@@ -462,9 +462,10 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
     }
     const NormalImpulse<S> normal = normal_impulse<M, S, FastMode>(a, b, c, g);
     apply_impulse(a, b, c.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
+    Vec3<S> jv = c.n * normal.jn;
+    canonical_outputs(a, b, jv);  // as resolve_contacts
     if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
     if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
-    const Vec3<S> jv = c.n * normal.jn;
     impulses.j.x[k] = jv.x[0];
     impulses.j.y[k] = jv.y[0];
     impulses.j.z[k] = jv.z[0];

@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <experimental/simd>
+#include <limits>
 #include <type_traits>
 #if defined(__AVX2__) || defined(__AVX512F__)
 #include <immintrin.h>
@@ -204,6 +205,20 @@ COLLIDE_LANE_INLINE V lane_sqrt(const V& x) {
 template <class V>
 COLLIDE_LANE_INLINE V lane_min(const V& a, const V& b) {
   return select(b < a, b, a);
+}
+
+/// x with every NaN lane replaced by one NaN, the positive quiet NaN
+/// without payload. Which NaN an operation on two NaNs returns depends on
+/// the order of its operands (x86 returns the first), and the compiler may
+/// order the operands of + and * differently for a scalar and a vector lane
+/// type: a contact whose law overflowed gave -NaN on the scalar path and
+/// +NaN on the SIMD one. The law's outputs pass through this, so a NaN
+/// leaves the kernel with the same bits on every path and ISA; no operation
+/// of the law depends on a NaN's sign.
+template <class V>
+COLLIDE_LANE_INLINE V canonical_nan(const V& x) {
+  using T = typename V::value_type;
+  return select(x == x, x, V(std::numeric_limits<T>::quiet_NaN()));
 }
 
 /// A 3-vector of lanes.
