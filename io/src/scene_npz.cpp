@@ -258,6 +258,12 @@ void LoadedBodies<T>::check() const {
 }
 
 template <class T>
+void LoadedBodies<T>::fill_solve_arrays(T* inv_mass, const Vec3Array<T>& inv_inertia, const Vec3Array<T>& v,
+                                        const Vec3Array<T>& w) const {
+  if (!screened_solve_arrays(columns_, inv_mass, inv_inertia, v, w)) check();
+}
+
+template <class T>
 LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRules rules) {
   LoadedBodies<T> out;
   if (format == SceneFormat::csv) {
@@ -304,16 +310,16 @@ T* allocate_large(std::size_t n) {
 }  // namespace
 
 template <class T>
-bool SolveBodies<T>::fill(const BodyColumns<T>& columns) {
+BodyView<T> SolveBodies<T>::point_at(const BodyColumns<T>& columns) {
   for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
-  BodyView<T> v = view();
-  return screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w);
+  return view();
 }
 
 template <class T>
 SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
     : count_(columns.count), own_(allocate_large<T>(10 * columns.count)) {
-  if (!fill(columns)) {
+  const BodyView<T> v = point_at(columns);
+  if (!screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w)) {
     const std::optional<RowDefect> bad = first_body_defect(columns);
     throw std::invalid_argument("SolveBodies: row " + std::to_string(bad ? bad->row : 0) + ", column '" +
                                 std::string(bad ? bad->defect.column : "?") +
@@ -324,7 +330,8 @@ SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
 template <class T>
 SolveBodies<T>::SolveBodies(const LoadedBodies<T>& loaded)
     : count_(loaded.size()), own_(allocate_large<T>(10 * loaded.size())) {
-  if (!fill(loaded.columns())) loaded.check();
+  const BodyView<T> v = point_at(loaded.columns());
+  loaded.fill_solve_arrays(v.inv_mass, v.inv_inertia, v.v, v.w);
 }
 
 template <class T>

@@ -118,9 +118,7 @@ py::tuple load_t(const std::string& bodies_path, const std::string& contacts_pat
   py::array ang = new_array(d, {3, rows});
   {
     py::gil_scoped_release release;
-    if (!screened_solve_arrays(bc, data<T>(inv_mass), vec3<T>(inv_inertia), vec3<T>(vel), vec3<T>(ang))) {
-      lb->check();
-    }
+    lb->fill_solve_arrays(data<T>(inv_mass), vec3<T>(inv_inertia), vec3<T>(vel), vec3<T>(ang));
     lc = std::make_shared<LoadedContacts<T>>(
         load_contacts<T>(contacts_path, scene_format_of(contacts_path), lb->size()));
   }

@@ -66,10 +66,10 @@ std::string_view to_string(SceneFormat format);
 NpyType npz_scene_precision(const NpzArchive& archive);
 
 /// Whether load_bodies checks the rules of every body (`checked`), or leaves
-/// that to its caller (`by_caller`), who must call LoadedBodies::check(), or
-/// SolveBodies' checking constructor, before using a value: a caller that
-/// reads every column anyway checks them in the same pass
-/// (screened_solve_arrays). A CSV file is checked as it is parsed either way.
+/// that to its caller (`by_caller`), who must call LoadedBodies::check() or
+/// LoadedBodies::fill_solve_arrays() (SolveBodies' constructor from a loaded
+/// file calls it) before using a value: a caller that reads every column
+/// anyway checks them in the same pass. A CSV file is checked as it is parsed either way.
 enum class BodyRules { checked, by_caller };
 
 /// A bodies file of either format, loaded for a solve in precision T: its
@@ -81,6 +81,13 @@ class LoadedBodies {
   /// Throws the SceneError of the first body that breaks a rule (the file,
   /// the row, the column and the reason); returns when none does.
   void check() const;
+  /// The arrays a solve writes, size() values each (1/m, 1/I, and v and w
+  /// copied), filled in the pass that checks the rules
+  /// (screened_solve_arrays): check()'s SceneError for a body that breaks
+  /// one. What a caller of a `by_caller` load that reads every column calls
+  /// instead of check().
+  void fill_solve_arrays(T* inv_mass, const Vec3Array<T>& inv_inertia, const Vec3Array<T>& v,
+                         const Vec3Array<T>& w) const;
   [[nodiscard]] const BodyColumns<T>& columns() const { return columns_; }
   [[nodiscard]] std::size_t size() const { return columns_.count; }
   /// True when at least one column is used in place, in the file's mapping.
@@ -145,8 +152,8 @@ class SolveBodies {
   [[nodiscard]] std::size_t size() const { return count_; }
 
  private:
-  /// q and p pointed at, the arrays filled; false when a body breaks a rule.
-  bool fill(const BodyColumns<T>& columns);
+  /// q and p pointed at `columns`; the view of the arrays to fill.
+  BodyView<T> point_at(const BodyColumns<T>& columns);
   std::size_t count_ = 0;
   struct Free {
     void operator()(T* p) const noexcept;
