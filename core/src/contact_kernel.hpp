@@ -253,9 +253,9 @@ COLLIDE_LANE_INLINE void apply_impulse(BodyLanes<M, V>& a, BodyLanes<M, V>& b, c
 /// (2^600) below, by 2^-88 (2^-600) above, which brings every finite ut to
 /// where its square neither underflows nor overflows. Scaling by a power of
 /// two is exact, so a lane gets the same bits whether it was scaled or not,
-/// and the choice is the lane's own (test_sliding_direction). It replaced
-/// dividing ut by its largest component, six divisions per contact
-/// (collide_bench, 64k pairs, float, 1 thread: sphere with friction 1.07x).
+/// and the choice is the lane's own (test_sliding_direction). Two selects
+/// and a multiply, where dividing ut by its largest component would cost a
+/// division per component.
 template <class V>
 struct SlidingDirection {
   Vec3<V> unit;     // ut times the scale (divide by scaled_length for t)
@@ -372,10 +372,9 @@ COLLIDE_LANE_INLINE V compensated_normal_impulse(const V& vh, const V& vl, const
 ///     model forms u . n and the quotient compensated
 ///     (compensated_particle_vn, compensated_normal_impulse), so that its
 ///     jn is rounded once; the rigid and sphere models divide in double.
-/// The particle model was up to 2.8 eps-units on the report's scenes, a
-/// single contact's rounding (hard_attribution: the normal taken as unit,
-/// vn and the quotient, each up to 1.5 to 1.8 alone); it is now one
-/// rounding of jn and one of J = jn n (0.8).
+/// The particle model's error is then one rounding of jn and one of
+/// J = jn n: taking the normal as unit, vn rounded and the quotient rounded
+/// each cost up to 1.5 to 1.8 eps-units alone (tests/hard/hard_attribution.cpp).
 template <class M, class V>
 COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
                                                          const Vec3<V>& u, const Vec3<V>& n, const V& e,
@@ -423,11 +422,21 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
   return r;
 }
 
-/// What the law needs of a contact that does not depend on the velocities:
-/// the offsets and the lever arms along n. A run of contacts that must be
-/// applied one after another (solve_run in kernel_isa.cpp) forms these in
-/// lanes first and then walks the contacts one by one with them; the one
-/// kernel body below forms them in place. Either way the same operations.
+// The law in two halves
+// ----------------------
+// What the law needs of a contact splits into a velocity-free part, its
+// geometry (the offsets, the lever arms along n and their K terms: most of
+// the arithmetic, and all of the float kernel's double-lane work), and the
+// velocity step (the normal impulse, its application and the Coulomb step),
+// which reads the velocities the earlier contacts left. Every kernel
+// composes the two: the lanes form both at once (evaluate_law), a run of
+// contacts applied one after another forms the geometry in lanes and then
+// steps the contacts one by one (kernel_isa.cpp, piece_walk). No contact of a
+// solve changes a position or an orientation, so the geometry may be formed
+// before the contacts ahead of it are stepped; either way the operations on
+// every value are the same.
+
+/// The velocity-free half of the law for W contacts.
 template <class V>
 struct ContactGeometry {
   Vec3<V> ra;  // [m] c - pa (sphere, rigid)
@@ -475,58 +484,66 @@ COLLIDE_LANE_INLINE NormalImpulse<V> normal_impulse(const BodyLanes<M, V>& a, co
   return normal;
 }
 
+/// The Coulomb step of W contacts after their normal impulse (jn, applied
+/// where `approaching`): stops the sliding where the cone allows, and adds
+/// the friction impulse to `j`. Reads the bodies' velocities and, for the
+/// lever arms along the sliding direction, their geometry.
+template <class M, class V, class Mode>
+COLLIDE_LANE_INLINE void coulomb_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b, const ContactLanes<V>& contact,
+                                      const ContactGeometry<V>& g, const NormalImpulse<V>& normal, Vec3<V>& j) {
+  const Vec3<V>& n = contact.n;
+  const auto may_slide = normal.approaching && (contact.mu > V(0));
+  if (!stdx::any_of(may_slide)) return;
+  const Vec3<V> u_after = relative_velocity(a, b, g.ra, g.rb);
+  // The tangential part of u' about the law's unit normal n / |n|. The
+  // accurate mode's n is unit in its wider lanes; the fast mode's is the
+  // caller's, unit within the input tolerance, so its projection divides by
+  // |n|^2 (taking |n| = 1 would leave a normal component of (|n|^2 - 1) u'.n
+  // in ut, up to 2e-3 of it).
+  Vec3<V> ut;
+  if constexpr (std::is_same_v<Mode, FastMode>) {
+    ut = u_after - n * (dot(u_after, n) / dot(n, n));
+  } else {
+    ut = u_after - n * dot(u_after, n);
+  }
+  const SlidingDirection<V> slide = sliding_direction(ut);
+  // Slides when ut is nonzero and every component finite (scaled, they are
+  // at most 2^40); a NaN or inf component never slides. |ut| itself may
+  // still overflow to inf, and then jt = mu jn.
+  const auto sliding = may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
+  const Vec3<V> t = slide.unit * (V(1) / select(sliding, slide.scaled_length, V(1)));
+  const LeverArm<V> tarm_a = lever_arm(a, g.ra, t, contact.c);
+  const LeverArm<V> tarm_b = lever_arm(b, g.rb, t, contact.c);
+  const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
+  // The Coulomb cap is mu times the law's normal impulse, |P| = |jn n|: jn
+  // itself in the accurate mode (n unit), jn |n| in the fast mode.
+  V cap = contact.mu * normal.jn;
+  if constexpr (std::is_same_v<Mode, FastMode>) cap = cap * lane_sqrt(dot(n, n));
+  const V jt = select(sliding, lane_min(slide.speed / k_t, cap), V(0));
+  apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
+  j = select(sliding, j - t * jt, j);
+}
+
+/// The velocity step of W contacts whose bodies are pairwise distinct (or
+/// immovable), given their geometry: the normal impulse applied, then, with
+/// kFriction, the Coulomb step (without it `mu` is never read). Returns J.
+template <class M, class V, bool kFriction, class Mode>
+COLLIDE_LANE_INLINE ContactResult<V> velocity_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                   const ContactLanes<V>& contact, const ContactGeometry<V>& g) {
+  const NormalImpulse<V> normal = normal_impulse<M, V, Mode>(a, b, contact, g);
+  apply_impulse(a, b, contact.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
+  ContactResult<V> result{contact.n * normal.jn};
+  if constexpr (kFriction) coulomb_step<M, V, Mode>(a, b, contact, g, normal, result.j);
+  return result;
+}
+
 /// The law for W contacts whose bodies are pairwise distinct (or immovable),
-/// evaluated in the lanes V. kFriction selects the Coulomb step; without it
-/// `mu` is never read.
+/// evaluated in the lanes V: the geometry, then the velocity step.
 template <class M, class V, bool kFriction, class Mode>
 COLLIDE_LANE_INLINE ContactResult<V> evaluate_law(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                   const ContactLanes<V>& contact) {
-  const Vec3<V>& n = contact.n;
   const ContactGeometry<V> g = contact_geometry(a, b, contact);
-  const Vec3<V>& ra = g.ra;
-  const Vec3<V>& rb = g.rb;
-  const LeverArm<V>& arm_a = g.arm_a;
-  const LeverArm<V>& arm_b = g.arm_b;
-  const NormalImpulse<V> normal = normal_impulse<M, V, Mode>(a, b, contact, g);
-  const auto& approaching = normal.approaching;
-  const V& jn = normal.jn;
-  apply_impulse(a, b, n, jn, arm_a, arm_b, approaching);
-
-  ContactResult<V> result{n * jn};
-  if constexpr (kFriction) {
-    const auto may_slide = approaching && (contact.mu > V(0));
-    if (stdx::any_of(may_slide)) {
-      const Vec3<V> u_after = relative_velocity(a, b, ra, rb);
-      // The tangential part of u' about the law's unit normal n / |n|. The
-      // accurate mode's n is unit in its wider lanes; the fast mode's is the
-      // caller's, unit within the input tolerance, so its projection divides
-      // by |n|^2 (taking |n| = 1 would leave a normal component of
-      // (|n|^2 - 1) u'.n in ut, up to 2e-3 of it).
-      Vec3<V> ut;
-      if constexpr (std::is_same_v<Mode, FastMode>) {
-        ut = u_after - n * (dot(u_after, n) / dot(n, n));
-      } else {
-        ut = u_after - n * dot(u_after, n);
-      }
-      const SlidingDirection<V> slide = sliding_direction(ut);
-      // Slides when ut is nonzero and every component finite (scaled, they
-      // are at most 2^40); a NaN or inf component never slides. |ut| itself
-      // may still overflow to inf, and then jt = mu jn.
-      const auto sliding = may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
-      const Vec3<V> t = slide.unit * (V(1) / select(sliding, slide.scaled_length, V(1)));
-      const LeverArm<V> tarm_a = lever_arm(a, ra, t, contact.c);
-      const LeverArm<V> tarm_b = lever_arm(b, rb, t, contact.c);
-      const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
-      // The Coulomb cap is mu times the law's normal impulse, |P| = |jn n|:
-      // jn itself in the accurate mode (n unit), jn |n| in the fast mode.
-      V cap = contact.mu * jn;
-      if constexpr (std::is_same_v<Mode, FastMode>) cap = cap * lane_sqrt(dot(n, n));
-      const V jt = select(sliding, lane_min(slide.speed / k_t, cap), V(0));
-      apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
-      result.j = select(sliding, result.j - t * jt, result.j);
-    }
-  }
-  return result;
+  return velocity_step<M, V, kFriction, Mode>(a, b, contact, g);
 }
 
 /// One side's bodies in the accurate mode's lanes (exact: widening).
@@ -596,6 +613,13 @@ COLLIDE_LANE_INLINE void canonical_outputs(BodyLanes<M, V>& a, BodyLanes<M, V>& 
     each(b.w);
   }
   each(j);
+}
+
+/// J of the passes before plus this pass's (SolverOptions::passes), every
+/// NaN the one NaN: the sum a caller would form of the passes' J in turn.
+template <class V>
+COLLIDE_LANE_INLINE Vec3<V> summed_impulse(const Vec3<V>& before, const Vec3<V>& j) {
+  return {canonical_nan(before.x + j.x), canonical_nan(before.y + j.y), canonical_nan(before.z + j.z)};
 }
 
 /// The law for W contacts in the mode `Mode` (FastMode or AccurateMode).

@@ -137,10 +137,11 @@ COLLIDE_LANE_INLINE void gather_bodies(const View& bodies, const BodyIndex* ia, 
   }
 }
 
-/// Resolves one group of V::size() contacts.
+/// Resolves one group of V::size() contacts; with `accumulate`, adds J to
+/// the impulses there (a later pass).
 template <class M, class V, bool kFriction, class Mode, class T, class View>
 COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                                     const ContactGroup& g) {
+                                     const ContactGroup& g, bool accumulate) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
   BodyIndex ib[W];
@@ -203,15 +204,26 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
     write_records<M, V>(bodies, ia, a, movable_a);
     write_records<M, V>(bodies, ib, b, movable_b);
   }
+  Vec3<V> j = r.j;
   if (g.contiguous) {
-    store(r.j.x, impulses.j.x + g.first);
-    store(r.j.y, impulses.j.y + g.first);
-    store(r.j.z, impulses.j.z + g.first);
+    if (accumulate) {
+      j = summed_impulse(
+          Vec3<V>{load<V>(impulses.j.x + g.first), load<V>(impulses.j.y + g.first), load<V>(impulses.j.z + g.first)},
+          j);
+    }
+    store(j.x, impulses.j.x + g.first);
+    store(j.y, impulses.j.y + g.first);
+    store(j.z, impulses.j.z + g.first);
   } else {
+    if (accumulate) {
+      j = summed_impulse(
+          Vec3<V>{gather<V>(impulses.j.x, g.index), gather<V>(impulses.j.y, g.index), gather<V>(impulses.j.z, g.index)},
+          j);
+    }
     const auto all = V(0) == V(0);
-    scatter(r.j.x, impulses.j.x, g.index, all);
-    scatter(r.j.y, impulses.j.y, g.index, all);
-    scatter(r.j.z, impulses.j.z, g.index, all);
+    scatter(j.x, impulses.j.x, g.index, all);
+    scatter(j.y, impulses.j.y, g.index, all);
+    scatter(j.z, impulses.j.z, g.index, all);
   }
 }
 
@@ -225,11 +237,10 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
 /// one after another. In a scattered batch the contact's own lines (its body
 /// indices, fields and J) are requested twice as far ahead: the record
 /// requests read the body indices, which would otherwise be a demand miss
-/// of their own and stall the loop at every contact. That replaced copying
-/// the contacts into schedule order before the solve (and J back after):
-/// measured alternately in one process (debris, rigid, float, AVX-512, 2
-/// threads), the copy was no faster at 4M contacts, 20-30% slower at 1M, 5%
-/// faster in cache at 64k, and cost 56 bytes per contact of scratch.
+/// of their own and stall the loop at every contact. Copying the contacts
+/// into schedule order before the solve (and J back after) would do the
+/// same with scratch of 56 bytes per contact and two more passes over them,
+/// and was no faster (docs/decisions/0005-packed-records-for-scattered-contacts.md).
 inline constexpr std::size_t kPrefetchAhead = COLLIDE_PREFETCH_AHEAD;
 
 /// Asks for the lines of contact k's fields and of its J: a scattered batch
@@ -253,7 +264,7 @@ COLLIDE_LANE_INLINE void prefetch_contact(const ContactView<T>& c, const Impulse
 template <class M, class V, bool kFriction, class Mode, class T, class View>
 COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactView<T>& contacts,
                                              const ImpulseView<T>& impulses, const std::uint32_t* order,
-                                             bool contiguous, std::size_t begin, std::size_t end) {
+                                             bool contiguous, bool accumulate, std::size_t begin, std::size_t end) {
   constexpr std::size_t W = V::size();
   std::size_t i = begin;
   if constexpr (!kSoaLayout<View>) {
@@ -277,14 +288,15 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
           prefetch_record(bodies, contacts.a[order[k]]);
           prefetch_record(bodies, contacts.b[order[k]]);
         }
-        solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses,
-                                              ContactGroup{contiguous, order[i], order + i});
+        solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i},
+                                              accumulate);
       }
       return i;
     }
   }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i});
+    solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i},
+                                          accumulate);
   }
   return i;
 }
@@ -320,10 +332,10 @@ std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::s
   // `view` is a SoA view or a PackedView: solve_group tells them apart.
   return with_view(job, [&](const auto& view, auto model) {
     using M = decltype(model);
-    return job.friction
-               ? solve_groups<M, V, true, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin, end)
-               : solve_groups<M, V, false, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous, begin,
-                                                    end);
+    return job.friction ? solve_groups<M, V, true, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous,
+                                                            job.accumulate, begin, end)
+                        : solve_groups<M, V, false, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous,
+                                                             job.accumulate, begin, end);
   });
 }
 
@@ -432,12 +444,12 @@ void piece_geometry(const View& bodies, const ContactView<T>& contacts, const st
 }
 
 /// The walk of the contacts order[0, count) of a piece, in order, in one
-/// lane: each reads the velocities the contacts before it left and applies
-/// its impulse. Every value is formed by the operations evaluate_law performs
-/// on it (contact_geometry, normal_impulse, apply_impulse), so the bits are
-/// those of the one-lane kernel.
+/// lane: each reads the velocities the contacts before it left and takes the
+/// law's velocity step (velocity_step) with the geometry piece_geometry
+/// formed: the two halves evaluate_law composes, so the bits are those of
+/// the one-lane kernel.
 template <class M, class T, class View>
-void piece_walk(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+void piece_walk(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses, bool accumulate,
                 const std::uint32_t* order, std::size_t count, const RunPiece<T>& piece) {
   using S = ScalarLanes<T>;
   for (std::size_t j = 0; j < count; ++j) {
@@ -460,10 +472,10 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
       g.arm_a = {load3<S>(piece.response_a, j), S(piece.k_a[j])};
       g.arm_b = {load3<S>(piece.response_b, j), S(piece.k_b[j])};
     }
-    const NormalImpulse<S> normal = normal_impulse<M, S, FastMode>(a, b, c, g);
-    apply_impulse(a, b, c.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
-    Vec3<S> jv = c.n * normal.jn;
-    canonical_outputs(a, b, jv);  // as resolve_contacts
+    ContactResult<S> r = velocity_step<M, S, false, FastMode>(a, b, c, g);
+    canonical_outputs(a, b, r.j);  // as resolve_contacts
+    Vec3<S> jv = r.j;
+    if (accumulate) jv = summed_impulse(Vec3<S>{S(impulses.j.x[k]), S(impulses.j.y[k]), S(impulses.j.z[k])}, jv);
     if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
     if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
     impulses.j.x[k] = jv.x[0];
@@ -477,12 +489,12 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
 /// this thread: piece after piece, its geometry and then its walk.
 template <class M, class V, class T, class View>
 void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                      const std::uint32_t* order, std::size_t begin, std::size_t end) {
+                      bool accumulate, const std::uint32_t* order, std::size_t begin, std::size_t end) {
   RunPiece<T> piece;
   for (std::size_t first = begin; first < end; first += kRunPiece) {
     const std::size_t count = std::min(kRunPiece, end - first);
     piece_geometry<M, V, T>(bodies, contacts, order + first, count, piece);
-    piece_walk<M, T>(bodies, contacts, impulses, order + first, count, piece);
+    piece_walk<M, T>(bodies, contacts, impulses, accumulate, order + first, count, piece);
   }
 }
 
@@ -498,7 +510,7 @@ template <class T>
 void run_piece_walk(const KernelJob<T>& job, std::size_t first, std::size_t count, const RunPiece<T>& piece) {
   assert(!job.accurate && !job.friction);
   with_view(job, [&](const auto& view, auto model) {
-    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.order + first, count, piece);
+    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + first, count, piece);
   });
 }
 
@@ -511,7 +523,8 @@ void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
     return;
   }
   with_view(job, [&](const auto& view, auto model) {
-    solve_run_pieces<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.impulses, job.order, begin, end);
+    solve_run_pieces<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.impulses, job.accumulate, job.order,
+                                                       begin, end);
   });
 }
 

@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
@@ -40,6 +41,9 @@ struct KernelJob {
   bool friction = false;  ///< contacts.mu is set: run the Coulomb step
   bool packed = false;    ///< the bodies are in a packed_* member, not a SoA view
   bool accurate = false;  ///< Accuracy::accurate: the law in wider lanes (exact_lanes.hpp)
+  /// J is added to what the impulse arrays hold (the passes after the first,
+  /// SolverOptions::passes) rather than written.
+  bool accumulate = false;
   BodyView<T> rigid;
   SphereView<T> sphere;
   ParticleView<T> particle;
@@ -106,6 +110,16 @@ struct KernelTable {
   RunWalkKernel<float> run_walk_float = nullptr;
   RunWalkKernel<double> run_walk_double = nullptr;
 };
+
+/// The entry of a KernelTable for precision T: its float one or its double one.
+template <class T, class F, class D>
+auto of_precision(const F& for_float, const D& for_double) {
+  if constexpr (std::is_same_v<T, float>) {
+    return for_float;
+  } else {
+    return for_double;
+  }
+}
 
 /// The table of a concrete ISA (not automatic) that this build has.
 const KernelTable& kernel_table(Isa isa);

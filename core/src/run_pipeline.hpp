@@ -1,6 +1,6 @@
 // run_pipeline.hpp - a run of one-contact batches (a chain, a stack) on two
-// threads: one forms the geometry of the pieces ahead while the other walks
-// the contacts in order.
+// threads: one walks the contacts in order while the other forms the
+// geometry of the pieces ahead.
 //
 // Design notes
 // ------------
@@ -19,20 +19,16 @@
 //   for the walk to free a slot), or the walker itself when it reaches a
 //   piece nobody has claimed. So the walker never waits for a piece that is
 //   not being formed.
-// * The calling thread walks; the helper is a task another thread of the
-//   arena may take (tbb::task_group). If none does, the calling thread runs
-//   it after the walk, when every piece is claimed and it returns at once.
-//   So the helper waits for the walk only while the walk runs on another
-//   thread, nothing can deadlock, and the walk ends whether the helper runs
-//   at once, late or never (an arena thread busy elsewhere).
+// * One thread walks; the others, waiting for the run to end (the schedule
+//   walk, run_schedule.cpp), help. A helper waits for the walk only while
+//   the walk runs on another thread, nothing can deadlock, and the walk ends
+//   whether a helper comes at once, late or never.
 // * The same geometry and the same walk as solve_run, in the same order for
 //   every contact: the same bits on one thread or two.
 // * SoA layouts only: the geometry reads positions, orientations and inverse
 //   masses, never the velocities the walk writes (a packed record holds
 //   both, so packed runs stay on one thread).
 #pragma once
-
-#include <oneapi/tbb/task_group.h>
 
 #include <algorithm>
 #include <array>
@@ -55,67 +51,101 @@ inline constexpr std::size_t kRunSlots = 4;
 /// Runs of at least this many pieces are worth a second thread.
 inline constexpr std::size_t kPipelinedRunPieces = 4;
 
-/// One step of a spin-wait.
-inline void spin_pause() {
+/// A wait for another thread of the solve: a few microseconds of pauses,
+/// the time a hand-over between two running threads takes, then a yield of
+/// the processor at every step, so that on a machine with more threads
+/// running than cores the thread waited for gets the core instead of the
+/// waiting one spinning through its time slice.
+class SpinWait {
+ public:
+  void pause() {
+    if (spins_ < kSpins) {
+      ++spins_;
 #if defined(__x86_64__) || defined(__i386__)
-  _mm_pause();
-#else
-  std::this_thread::yield();
+      _mm_pause();
 #endif
-}
+    } else {
+      std::this_thread::yield();
+    }
+  }
 
-/// Resolves order[begin, end) as solve_run does, with the pieces' geometry
-/// formed on a second thread of the calling arena where one is free.
-/// Preconditions: fast mode, no friction, a SoA body layout.
+ private:
+  static constexpr int kSpins = 256;
+  int spins_ = 0;
+};
+
+/// A run of contacts order[begin, end) resolved as solve_run does, its
+/// pieces' geometry formed by whichever threads call help() while one thread
+/// calls walk(). Preconditions: fast mode, no friction, a SoA body layout.
 template <class T>
-void run_pipelined(RunGeometryKernel<T> geometry, RunWalkKernel<T> walk, const KernelJob<T>& job, std::size_t begin,
-                   std::size_t end) {
+class PipelinedRun {
+ public:
+  PipelinedRun(RunGeometryKernel<T> geometry, RunWalkKernel<T> walk, const KernelJob<T>& job, std::size_t begin,
+               std::size_t end)
+      : geometry_(geometry),
+        walk_(walk),
+        job_(job),
+        begin_(begin),
+        end_(end),
+        pieces_((end - begin + kRunPiece - 1) / kRunPiece) {}
+
+  /// The walk, on the calling thread: every piece in order, forming those
+  /// no helper has claimed. Returns when the run is resolved.
+  void walk() {
+    for (std::size_t i = 0; i < pieces_; ++i) {
+      std::size_t unclaimed = i;
+      if (claimed_.compare_exchange_strong(unclaimed, i + 1, std::memory_order_relaxed)) {
+        form(i);
+      } else {
+        SpinWait wait;
+        while (slots_[i % kRunSlots].holds.load(std::memory_order_acquire) != i + 1) wait.pause();
+      }
+      walk_(job_, first_of(i), count_of(i), slots_[i % kRunSlots].piece);
+      // Release: the walk's reads of the slot come before a helper refills it.
+      walked_.store(i + 1, std::memory_order_release);
+    }
+  }
+
+  /// Forms pieces ahead of the walk, at most kRunSlots ahead of it; returns
+  /// once every piece is claimed (by a helper or the walker).
+  void help() {
+    SpinWait wait;
+    for (;;) {
+      std::size_t i = claimed_.load(std::memory_order_relaxed);
+      if (i >= pieces_) return;
+      const std::size_t done = walked_.load(std::memory_order_acquire);
+      if (i >= done + kRunSlots) {
+        // The slot of piece i still holds one the walk has not finished.
+        wait.pause();
+        continue;
+      }
+      if (claimed_.compare_exchange_weak(i, i + 1, std::memory_order_relaxed)) form(i);
+    }
+  }
+
+ private:
   struct Slot {
     RunPiece<T> piece;
     std::atomic<std::size_t> holds{0};  // 1 + the piece whose geometry is complete here
   };
-  const std::size_t pieces = (end - begin + kRunPiece - 1) / kRunPiece;
-  std::array<Slot, kRunSlots> slots;
-  std::atomic<std::size_t> claimed{0};  // pieces taken by the helper or the walker, in order
-  std::atomic<std::size_t> walked{0};   // pieces the walk is done with
-  const auto first_of = [&](std::size_t i) { return begin + i * kRunPiece; };
-  const auto count_of = [&](std::size_t i) { return std::min(kRunPiece, end - first_of(i)); };
-  const auto form = [&](std::size_t i) {
-    Slot& slot = slots[i % kRunSlots];
-    geometry(job, first_of(i), count_of(i), slot.piece);
+
+  [[nodiscard]] std::size_t first_of(std::size_t i) const { return begin_ + i * kRunPiece; }
+  [[nodiscard]] std::size_t count_of(std::size_t i) const { return std::min(kRunPiece, end_ - first_of(i)); }
+  void form(std::size_t i) {
+    Slot& slot = slots_[i % kRunSlots];
+    geometry_(job_, first_of(i), count_of(i), slot.piece);
     slot.holds.store(i + 1, std::memory_order_release);
-  };
-  const auto walker = [&] {
-    for (std::size_t i = 0; i < pieces; ++i) {
-      std::size_t unclaimed = i;
-      if (claimed.compare_exchange_strong(unclaimed, i + 1, std::memory_order_relaxed)) {
-        form(i);
-      } else {
-        while (slots[i % kRunSlots].holds.load(std::memory_order_acquire) != i + 1) spin_pause();
-      }
-      walk(job, first_of(i), count_of(i), slots[i % kRunSlots].piece);
-      // Release: the walk's reads of the slot come before the helper refills it.
-      walked.store(i + 1, std::memory_order_release);
-    }
-  };
-  const auto helper = [&] {
-    for (;;) {
-      std::size_t i = claimed.load(std::memory_order_relaxed);
-      if (i >= pieces) return;
-      const std::size_t done = walked.load(std::memory_order_acquire);
-      if (i >= done + kRunSlots) {
-        // The slot of piece i still holds one the walk has not finished;
-        // the walk runs on the calling thread meanwhile.
-        spin_pause();
-        continue;
-      }
-      if (claimed.compare_exchange_weak(i, i + 1, std::memory_order_relaxed)) form(i);
-    }
-  };
-  tbb::task_group group;
-  group.run(helper);
-  walker();
-  group.wait();
-}
+  }
+
+  RunGeometryKernel<T> geometry_;
+  RunWalkKernel<T> walk_;
+  const KernelJob<T>& job_;
+  std::size_t begin_;
+  std::size_t end_;
+  std::size_t pieces_;
+  std::array<Slot, kRunSlots> slots_;
+  std::atomic<std::size_t> claimed_{0};  // pieces taken by a helper or the walker, in order
+  std::atomic<std::size_t> walked_{0};   // pieces the walk is done with
+};
 
 }  // namespace collide::detail

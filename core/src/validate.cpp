@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "collide/rules.hpp"
+#include "contact_indices.hpp"
 #include "lanes.hpp"
 #include "screen_chunks.hpp"
 
@@ -70,38 +71,14 @@ struct BodyField {
   [[nodiscard]] T operator[](std::size_t i) const { return data[i * stride]; }
 };
 
-template <class T>
-std::vector<BodyField<T>> fields_of(const BodyView<T>& b) {
-  return {{"inv_mass", b.inv_mass, true},
-          {"inv_inertia.x", b.inv_inertia.x, true},
-          {"inv_inertia.y", b.inv_inertia.y, true},
-          {"inv_inertia.z", b.inv_inertia.z, true},
-          {"q.w", b.q.w, false},
-          {"q.x", b.q.x, false},
-          {"q.y", b.q.y, false},
-          {"q.z", b.q.z, false},
-          {"p.x", b.p.x, false},
-          {"p.y", b.p.y, false},
-          {"p.z", b.p.z, false},
-          {"v.x", b.v.x, false},
-          {"v.y", b.v.y, false},
-          {"v.z", b.v.z, false},
-          {"w.x", b.w.x, false},
-          {"w.y", b.w.y, false},
-          {"w.z", b.w.z, false}};
-}
-template <class T>
-std::vector<BodyField<T>> fields_of(const SphereView<T>& b) {
-  return {{"inv_mass", b.inv_mass, true}, {"inv_inertia", b.inv_inertia, true},
-          {"p.x", b.p.x, false},          {"p.y", b.p.y, false},
-          {"p.z", b.p.z, false},          {"v.x", b.v.x, false},
-          {"v.y", b.v.y, false},          {"v.z", b.v.z, false},
-          {"w.x", b.w.x, false},          {"w.y", b.w.y, false},
-          {"w.z", b.w.z, false}};
-}
-template <class T>
-std::vector<BodyField<T>> fields_of(const ParticleView<T>& b) {
-  return {{"inv_mass", b.inv_mass, true}, {"v.x", b.v.x, false}, {"v.y", b.v.y, false}, {"v.z", b.v.z, false}};
+/// The arrays of a SoA view (for_each_array), with their rules.
+template <class View, class T = std::remove_const_t<std::remove_pointer_t<decltype(View::inv_mass)>>>
+std::vector<BodyField<T>> fields_of(const View& b) {
+  std::vector<BodyField<T>> fields;
+  for_each_array(b, [&](const char* name, const T* data, ArrayRole role) {
+    fields.push_back({name, data, role == ArrayRole::inverse});
+  });
+  return fields;
 }
 
 /// The fields of packed records, in the order of the SoA views' (so the
@@ -325,23 +302,10 @@ bool screen_quaternion(const std::array<const T*, 4>& q, std::size_t n) {
 }
 
 // The index screen is the one check of every call (memory safety, even with
-// check=False in the Python module) and SSE2 has no unsigned 32-bit compare:
-// with GCC on x86-64 it is also compiled for AVX2 and picked at load time
-// (an ifunc), about twice as fast. Integer compares only: the same verdict
-// from either clone.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+// check=False in the Python module): contact_indices.hpp's, shared with
+// Schedule::build.
 bool screen_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count) {
-  // Compared in 32 bits (so it vectorises); with 2^32 or more bodies the bound
-  // is one too strict for index 2^32 - 1, which then goes to the scan.
-  const auto n = static_cast<BodyIndex>(std::min<std::size_t>(body_count, std::numeric_limits<BodyIndex>::max()));
-  std::uint32_t bad = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    bad |= static_cast<std::uint32_t>(a[k] >= n) | static_cast<std::uint32_t>(b[k] >= n) |
-           static_cast<std::uint32_t>(a[k] == b[k]);
-  }
-  return bad == 0;
+  return detail::indices_below(a, b, count, detail::index_bound(body_count));
 }
 
 /// The body rules of validate_any's scan, screened over bodies [i0, i1) of
@@ -500,16 +464,8 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
   }
 
   for (std::size_t k = 0; k < contacts.count; ++k) {
-    if (contacts.a[k] >= bodies.count) {
-      return fail("contacts", "a", k, contacts.a[k],
-                  ("out of range (" + std::to_string(bodies.count) + " bodies)").c_str());
-    }
-    if (contacts.b[k] >= bodies.count) {
-      return fail("contacts", "b", k, contacts.b[k],
-                  ("out of range (" + std::to_string(bodies.count) + " bodies)").c_str());
-    }
-    if (contacts.a[k] == contacts.b[k]) {
-      return fail("contacts", "b", k, contacts.b[k], "a contact of a body with itself");
+    if (detail::first_bad_contact(contacts.a, contacts.b, k, k + 1, bodies.count) == k) {
+      return fail_text(detail::bad_contact_message(contacts.a, contacts.b, k, bodies.count));
     }
     const std::pair<const char*, const T*> finite[] = {{"c.x", contacts.c.x}, {"c.y", contacts.c.y},
                                                        {"c.z", contacts.c.z}, {"n.x", contacts.n.x},
@@ -567,15 +523,9 @@ Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t 
           count, [&](std::size_t k0, std::size_t k1) { return screen_indices(a + k0, b + k0, k1 - k0, body_count); })) {
     return {};
   }
-  for (std::size_t k = 0; k < count; ++k) {
-    // One branch per contact on the common path: all three checks at once.
-    if (a[k] < body_count && b[k] < body_count && a[k] != b[k]) continue;
-    const std::string range = "out of range (" + std::to_string(body_count) + " bodies)";
-    if (a[k] >= body_count) return fail("contacts", "a", k, a[k], range.c_str());
-    if (b[k] >= body_count) return fail("contacts", "b", k, b[k], range.c_str());
-    return fail("contacts", "b", k, b[k], "a contact of a body with itself");
-  }
-  return {};
+  const std::size_t k = detail::first_bad_contact(a, b, 0, count, body_count);
+  if (k == count) return {};
+  return fail_text(detail::bad_contact_message(a, b, k, body_count));
 }
 
 // Written out (clang-tidy: no macros over types).

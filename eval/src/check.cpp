@@ -120,8 +120,12 @@ StatRecord solve_record(const SolveStats& stats, const ImpulseView<const T>& imp
   r.emplace_back("layout", std::string(to_string(stats.layout)));
   r.emplace_back("accuracy", std::string(to_string(stats.accuracy)));
   r.emplace_back("lanes", U(stats.lanes));
+  r.emplace_back("order", std::string(to_string(stats.order)));
+  r.emplace_back("passes", U(stats.passes));
   r.emplace_back("batches", U(stats.batches));
   r.emplace_back("largest_batch", U(stats.largest_batch));
+  r.emplace_back("colours", U(stats.colours));
+  r.emplace_back("overflow_contacts", U(stats.overflow_contacts));
   r.emplace_back("schedule_seconds", schedule_seconds);
   r.emplace_back("isa_calibration_seconds", stats.isa_calibration_seconds);
   return r;

@@ -165,7 +165,7 @@ struct RefBody {
 /// the same J and velocities.
 template <class S, bool kErrorAnalysis>
 void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
-               ReferenceContact<S>* diagnostics) {
+               ReferenceContact<S>* diagnostics, const SolveSequence& sequence) {
   using V3 = Vec<S>;
   // The uncertainty each body's velocities inherit from the contacts applied
   // to it before (linear [m/s] and angular [rad/s], in units of C eps): a
@@ -179,7 +179,10 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
   // and the reference evaluated in double 57).
   std::vector<S> inherited_v(kErrorAnalysis ? bodies.count : 0, S(0));
   std::vector<S> inherited_w(kErrorAnalysis ? bodies.count : 0, S(0));
-  for (std::size_t k = 0; k < contacts.count; ++k) {
+  for (std::size_t step = 0; step < sequence.passes * contacts.count; ++step) {
+    const std::size_t pass = step / contacts.count;
+    const std::size_t at = step % contacts.count;
+    const std::size_t k = sequence.order != nullptr ? sequence.order[at] : at;
     const std::size_t ia = contacts.a[k];
     const std::size_t ib = contacts.b[k];
     RefBody<S> a(bodies, ia);
@@ -291,6 +294,8 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
       a.store(bodies, ia);
       b.store(bodies, ib);
     }
+    // J of the passes so far plus this one's.
+    if (pass > 0) j += V3(impulses.j.x[k], impulses.j.y[k], impulses.j.z[k]);
     impulses.j.x[k] = j.x();
     impulses.j.y[k] = j.y();
     impulses.j.z[k] = j.z();
@@ -301,7 +306,12 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
       inherited_w[ia] += d.impulse_scale * a.inv_inertia_max * ra.norm();
       inherited_v[ib] += d.impulse_scale * b.inv_mass;
       inherited_w[ib] += d.impulse_scale * b.inv_inertia_max * rb.norm();
-      if (diagnostics) diagnostics[k] = d;
+      // Over several passes J is a sum, off by at most the sum of the
+      // passes' errors: the scales add up.
+      if (diagnostics) {
+        if (pass > 0) d.impulse_scale += diagnostics[k].impulse_scale;
+        diagnostics[k] = d;
+      }
     }
   }
 }
@@ -310,24 +320,26 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
 
 template <class S>
 void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
-                     ReferenceContact<S>* diagnostics) {
-  solve_law<S, true>(bodies, contacts, impulses, diagnostics);
+                     ReferenceContact<S>* diagnostics, const SolveSequence& sequence) {
+  solve_law<S, true>(bodies, contacts, impulses, diagnostics, sequence);
 }
 
 template <class T>
 void textbook_solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses) {
-  solve_law<T, false>(bodies, contacts, impulses, nullptr);
+  solve_law<T, false>(bodies, contacts, impulses, nullptr, SolveSequence{});
 }
 template void textbook_solve<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&);
 template void textbook_solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&);
 
 template void reference_solve<double>(const BodyView<double>&, const ContactView<double>&, const ImpulseView<double>&,
-                                      ReferenceContact<double>*);
+                                      ReferenceContact<double>*, const SolveSequence&);
 template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
-                                           const ImpulseView<long double>&, ReferenceContact<long double>*);
+                                           const ImpulseView<long double>&, ReferenceContact<long double>*,
+                                           const SolveSequence&);
 #if COLLIDE_HAS_FLOAT128
 template void reference_solve<__float128>(const BodyView<__float128>&, const ContactView<__float128>&,
-                                          const ImpulseView<__float128>&, ReferenceContact<__float128>*);
+                                          const ImpulseView<__float128>&, ReferenceContact<__float128>*,
+                                          const SolveSequence&);
 #endif
 
 }  // namespace collide

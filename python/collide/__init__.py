@@ -73,20 +73,25 @@ __all__ = [
 __version__ = "0.1.0"
 
 
-def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", schedule=None, out=None,
-          check=True, impacts=True):
+def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", order="input",
+          passes=1, schedule=None, out=None, check=True, impacts=True):
     """Resolves every contact in place; returns ``(J, stats)``.
 
     ``bodies.v`` and ``bodies.w`` are updated; J (shape (3, M), the dtype of
     the scene) is the impulse on body a of each contact. ``stats`` has the keys
     of ``collide solve --stats`` (collisions, impacts, bodies, kernel_seconds,
     collisions_per_second, precision, threads, model, path, isa, isa_choice,
-    layout, accuracy, lanes, batches, largest_batch, schedule_seconds,
-    isa_calibration_seconds). ``model`` is "auto" (the
+    layout, accuracy, lanes, order, passes, batches, largest_batch, colours,
+    overflow_contacts, schedule_seconds, isa_calibration_seconds). ``model`` is "auto" (the
     cheapest that fits), "rigid", "sphere" or "particle"; ``path`` "simd" or
     "scalar"; ``threads`` 0 for all; ``isa`` None (automatic: COLLIDE_ISA,
     else the fastest on this CPU, measured once per process), "sse2", "avx2"
-    or "avx512"; ``accuracy`` "fast" or "accurate". For frame loops build a
+    or "avx512"; ``accuracy`` "fast" or "accurate". ``order`` is "input"
+    (the law in input order) or "colour" (an order collide chooses: windows
+    of contacts coloured over their bodies, several times faster on piles,
+    stacks and chains; docs/collision-law.md, "The solve order"); a
+    ``schedule`` given must have been built in it. ``passes`` resolves the
+    contacts that many times in that order, J summed. For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
     solving. Bad input raises TypeError or ValueError and modifies nothing.
 
@@ -104,22 +109,24 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     impulses (``stats["impacts"]`` is then None): at a million contacts that
     pass costs 5 to 10% of a particle solve.
     """
-    solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy)
+    solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy, order=order, passes=passes)
     return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, check=check, impacts=impacts)
 
 
-def reference_solve(bodies, contacts):
+def reference_solve(bodies, contacts, *, order="input", passes=1, schedule=None):
     """The high-precision reference (long double) on an exact copy of the inputs.
 
     The caller's bodies are not modified. Returns a :class:`Reference` with
     ``J`` (float64 (3, M)), the bodies' ``v`` and ``w`` after it, and
     ``impulse_scale`` per contact. Call it before :func:`solve` (which
-    updates the velocities) to compare the two with :func:`impulse_error`.
-    Packed bodies are unpacked first (an exact copy).
+    updates the velocities) to compare the two with :func:`impulse_error`,
+    with the solve's ``order`` and ``passes`` (or its ``schedule``): the
+    reference applies the law in the same sequence. Packed bodies are
+    unpacked first (an exact copy).
     """
     if isinstance(bodies, PackedBodies):
         bodies = bodies.unpack()
-    return _collide.reference_solve(bodies, contacts)
+    return _collide.reference_solve(bodies, contacts, order=order, passes=passes, schedule=schedule)
 
 
 def impulse_error(J, reference):

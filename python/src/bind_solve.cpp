@@ -59,8 +59,12 @@ Path parse_path(const std::string& s) {
   throw py::value_error("path must be 'simd' or 'scalar', got '" + s + "'");
 }
 
-SolverOptions solver_options(const std::string& path, int threads, const py::object& isa, const std::string& accuracy) {
+SolverOptions solver_options(const std::string& path, int threads, const py::object& isa, const std::string& accuracy,
+                             const std::string& order, int passes) {
   SolverOptions o;
+  o.order = parse_order(order);
+  if (passes < 1) throw py::value_error("passes must be >= 1, got " + std::to_string(passes));
+  o.passes = passes;
   o.path = parse_path(path);
   if (threads < 0 || threads > 4096) throw py::value_error("threads must be from 0 (all) to 4096");
   o.threads = threads;
@@ -90,6 +94,8 @@ struct PySchedule {
   std::size_t contacts = 0, bodies = 0;
   double build_seconds = 0;
 
+  explicit PySchedule(Order order = Order::input) : schedule(order) {}
+
   /// Schedule::build checks every index (std::invalid_argument naming the
   /// first bad one: a ValueError).
   template <class T, class B>
@@ -107,9 +113,9 @@ struct PySchedule {
 
   /// A schedule over validated input (it reads the indices).
   template <class B>
-  static std::unique_ptr<PySchedule> make(const B& bodies, const Contacts& contacts) {
+  static std::unique_ptr<PySchedule> make(const B& bodies, const Contacts& contacts, const std::string& order) {
     require_same_dtype(bodies, contacts);
-    auto s = std::make_unique<PySchedule>();
+    auto s = std::make_unique<PySchedule>(parse_order(order));
     with_dtype(bodies.dtype, [&](auto tag) {
       using T = decltype(tag);
       validate_or_throw<T>(bodies, contacts);
@@ -132,8 +138,9 @@ py::dict to_dict(const StatRecord& record) {
 struct PySolver {
   std::unique_ptr<Solver> solver;
 
-  PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy)
-      : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy))) {}
+  PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy,
+           const std::string& order, int passes)
+      : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy, order, passes))) {}
 
   template <class T, class B>
   py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
@@ -154,7 +161,7 @@ struct PySolver {
         throw py::value_error(v.message);
       }
     }
-    PySchedule own;
+    PySchedule own(solver->options().order);
     if (schedule == nullptr) {
       own.build<T>(bodies, contacts);  // before the model choice, which reads the bodies of every contact
       schedule = &own;
@@ -234,11 +241,25 @@ struct Reference {
   }
 };
 
-std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts) {
+std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const std::string& order,
+                                              int passes, const PySchedule* schedule) {
   require_same_dtype(bodies, contacts);
+  if (passes < 1) throw py::value_error("reference_solve: passes must be >= 1, got " + std::to_string(passes));
   return with_dtype(bodies.dtype, [&](auto tag) {
     using T = decltype(tag);
     validate_or_throw<T>(bodies, contacts);
+    // The solve's sequence: the given schedule's order, or the one a solve
+    // in `order` builds (a schedule depends on the input alone).
+    PySchedule own(parse_order(order));
+    if (schedule == nullptr) {
+      own.build<T>(bodies, contacts);
+      schedule = &own;
+    } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
+      throw py::value_error("reference_solve: schedule was built for " + std::to_string(schedule->contacts) +
+                            " contacts and " + std::to_string(schedule->bodies) + " bodies, not " +
+                            std::to_string(contacts.count) + " and " + std::to_string(bodies.count));
+    }
+    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes)};
     auto r = std::make_shared<Reference>();
     r->dtype = bodies.dtype;
     const BodyView<T> bv = bodies.view<T>();
@@ -249,7 +270,7 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
     r->impulses.resize(contacts.count);
     r->diagnostics.resize(contacts.count);
     r->before_totals = momentum_totals<long double>(std::as_const(r->after).view());
-    reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data());
+    reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data(), sequence);
     r->after_totals = momentum_totals<long double>(std::as_const(r->after).view());
     return r;
   });
@@ -313,19 +334,35 @@ class ThreadLimit {
 
 void register_solve(py::module_& m) {
   py::class_<PySchedule>(m, "Schedule")
-      .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"))
-      .def(py::init(&PySchedule::make<PackedBodies>), py::arg("bodies"), py::arg("contacts"))
+      .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("order") = "input")
+      .def(py::init(&PySchedule::make<PackedBodies>), py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+           py::arg("order") = "input")
+      .def_property_readonly("order", [](const PySchedule& s) { return to_string(s.schedule.ordering()); })
       .def_property_readonly("batches", [](const PySchedule& s) { return s.schedule.batch_count(); })
       .def_property_readonly("largest_batch", [](const PySchedule& s) { return s.schedule.largest_batch(); })
+      .def_property_readonly("colours", [](const PySchedule& s) { return s.schedule.colours(); })
+      .def_property_readonly("overflow_contacts", [](const PySchedule& s) { return s.schedule.overflow_contacts(); })
+      .def(
+          "solve_order",
+          [](const PySchedule& s) {
+            py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(s.schedule.contact_count()));
+            std::copy(s.schedule.order(), s.schedule.order() + s.schedule.contact_count(), out.mutable_data());
+            return out;
+          },
+          "The contact indices in the order a solve applies them (uint32, (M,)).")
       .def_readonly("build_seconds", &PySchedule::build_seconds);
 
   py::class_<PySolver>(m, "Solver")
-      .def(py::init<const std::string&, int, const py::object&, const std::string&>(), py::kw_only(),
-           py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(), py::arg("accuracy") = "fast")
+      .def(py::init<const std::string&, int, const py::object&, const std::string&, const std::string&, int>(),
+           py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
+           py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1)
       .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return to_string(s.solver->isa()); })
       .def_property_readonly("accuracy", [](const PySolver& s) { return to_string(s.solver->options().accuracy); })
+      .def_property_readonly("order", [](const PySolver& s) { return to_string(s.solver->options().order); })
+      .def_property_readonly("passes", [](const PySolver& s) { return s.solver->options().passes; })
       .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
            py::arg("check") = true, py::arg("impacts") = true)
@@ -352,7 +389,8 @@ void register_solve(py::module_& m) {
       .def_property_readonly("dtype", [](const Reference& r) { return numpy_dtype(r.dtype); })
       .def("__len__", [](const Reference& r) { return r.impulses.size(); });
 
-  m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"));
+  m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
+        py::arg("order") = "input", py::arg("passes") = 1, py::arg("schedule") = nullptr);
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("conservation_drift", &conservation_drift_py, py::arg("bodies"), py::arg("reference"));
   m.attr("accurate_error_ulps") = kAccurateErrorUlps;

@@ -26,7 +26,7 @@ namespace collide::test {
 template <class T>
 ImpulseBuffer<T> kernel_solve(BodyBuffer<T>& bodies, const ContactView<T>& contacts, const SolverOptions& options) {
   ImpulseBuffer<T> j(contacts.count);
-  Schedule schedule;
+  Schedule schedule(options.order);
   schedule.build(contacts, bodies.view());
   Solver(options).solve(bodies.view(), contacts, j.view(), schedule);
   return j;

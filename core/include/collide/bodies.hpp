@@ -96,6 +96,58 @@ struct ParticleView {
   Vec3Array<T> v;         ///< [m/s], updated
 };
 
+/// What the solver does with a body array (for_each_array).
+enum class ArrayRole {
+  inverse,   ///< an inverse mass or moment: read; finite and >= 0
+  state,     ///< a position or orientation component: read; finite
+  velocity,  ///< a velocity component: read, and written for movable bodies; finite
+};
+
+/// Calls f(name, array, role) for every array of the view, in member order:
+/// the one list of a view's arrays that the checks at the solver's
+/// boundaries (validate(), Solver::solve) walk.
+template <class T, class F>
+void for_each_array(const BodyView<T>& b, F&& f) {
+  f("inv_mass", b.inv_mass, ArrayRole::inverse);
+  f("inv_inertia.x", b.inv_inertia.x, ArrayRole::inverse);
+  f("inv_inertia.y", b.inv_inertia.y, ArrayRole::inverse);
+  f("inv_inertia.z", b.inv_inertia.z, ArrayRole::inverse);
+  f("q.w", b.q.w, ArrayRole::state);
+  f("q.x", b.q.x, ArrayRole::state);
+  f("q.y", b.q.y, ArrayRole::state);
+  f("q.z", b.q.z, ArrayRole::state);
+  f("p.x", b.p.x, ArrayRole::state);
+  f("p.y", b.p.y, ArrayRole::state);
+  f("p.z", b.p.z, ArrayRole::state);
+  f("v.x", b.v.x, ArrayRole::velocity);
+  f("v.y", b.v.y, ArrayRole::velocity);
+  f("v.z", b.v.z, ArrayRole::velocity);
+  f("w.x", b.w.x, ArrayRole::velocity);
+  f("w.y", b.w.y, ArrayRole::velocity);
+  f("w.z", b.w.z, ArrayRole::velocity);
+}
+template <class T, class F>
+void for_each_array(const SphereView<T>& b, F&& f) {
+  f("inv_mass", b.inv_mass, ArrayRole::inverse);
+  f("inv_inertia", b.inv_inertia, ArrayRole::inverse);
+  f("p.x", b.p.x, ArrayRole::state);
+  f("p.y", b.p.y, ArrayRole::state);
+  f("p.z", b.p.z, ArrayRole::state);
+  f("v.x", b.v.x, ArrayRole::velocity);
+  f("v.y", b.v.y, ArrayRole::velocity);
+  f("v.z", b.v.z, ArrayRole::velocity);
+  f("w.x", b.w.x, ArrayRole::velocity);
+  f("w.y", b.w.y, ArrayRole::velocity);
+  f("w.z", b.w.z, ArrayRole::velocity);
+}
+template <class T, class F>
+void for_each_array(const ParticleView<T>& b, F&& f) {
+  f("inv_mass", b.inv_mass, ArrayRole::inverse);
+  f("v.x", b.v.x, ArrayRole::velocity);
+  f("v.y", b.v.y, ArrayRole::velocity);
+  f("v.z", b.v.z, ArrayRole::velocity);
+}
+
 /// The sphere-model view of rigid bodies (uses inv_inertia.x as the one
 /// moment; see choose_model() in model.hpp for when that is the law).
 template <class T>

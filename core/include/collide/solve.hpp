@@ -4,8 +4,8 @@
 // does not depend on the path, the SIMD width or the thread count: all paths
 // run the same kernel body (core/src/contact_kernel.hpp) with the same IEEE
 // operations in the same order and no fused multiply-add, so they agree bit
-// for bit. Contacts that share a movable body are applied in input order
-// (see schedule.hpp).
+// for bit. Contacts that share a movable body are applied in the schedule's
+// order: input order, or the colour order collide chooses (schedule.hpp).
 #pragma once
 
 #include <cstddef>
@@ -73,6 +73,17 @@ struct SolverOptions {
   /// For SoA input: automatic packs it when that is faster (Solver::solve),
   /// soa never packs, packed always packs. Ignored for packed input.
   BodyLayout layout = BodyLayout::automatic;
+  /// The order contacts that share movable bodies are applied in
+  /// (schedule.hpp): each schedule a Solver is given must have been built in
+  /// it (Schedule(order)); the one-shot collide::solve() builds it so.
+  /// Order::input is the law in input order; Order::colour an order collide
+  /// chooses, several times faster on piles, stacks and chains.
+  Order order = Order::input;
+  /// Times the contacts are resolved in the schedule's order, each pass the
+  /// law as the velocities stand (>= 1). J is the sum over the passes, the
+  /// same bits as that many solves with their J added in turn (every NaN
+  /// the canonical one). The schedule serves every pass.
+  int passes = 1;
 };
 
 /// What a solve did.
@@ -94,6 +105,10 @@ struct SolveStats {
   double isa_calibration_seconds = 0;
   BodyLayout layout = BodyLayout::soa;  ///< the layout the kernel ran on (never automatic)
   Accuracy accuracy = Accuracy::fast;
+  Order order = Order::input;         ///< the schedule's order
+  std::size_t colours = 0;            ///< the colour order: Schedule::colours()
+  std::size_t overflow_contacts = 0;  ///< the colour order: Schedule::overflow_contacts()
+  std::size_t passes = 1;             ///< SolverOptions::passes
 };
 
 /// Number of lanes of the SIMD path for T under default_isa() (COLLIDE_ISA,

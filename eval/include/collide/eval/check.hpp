@@ -63,8 +63,8 @@ using StatRecord = std::vector<std::pair<std::string, StatValue>>;
 
 /// The record of one solve: collisions, impacts, bodies, kernel_seconds,
 /// collisions_per_second, precision, threads, model, path, isa, isa_choice,
-/// layout, accuracy, lanes, batches, largest_batch, schedule_seconds,
-/// isa_calibration_seconds. `kernel_seconds` is the wall time of the solve
+/// layout, accuracy, lanes, order, passes, batches, largest_batch, colours,
+/// overflow_contacts, schedule_seconds, isa_calibration_seconds. `kernel_seconds` is the wall time of the solve
 /// call; the ISA measurement it may contain (SolveStats::
 /// isa_calibration_seconds) is taken out of it and reported on its own.
 template <class T>

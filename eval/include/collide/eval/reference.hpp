@@ -1,8 +1,8 @@
-// collide/eval/reference.hpp - the collision law, written as the spec writes it.
+// collide/eval/reference.hpp - the collision law, written as docs/collision-law.md states it.
 //
 // This is the yardstick for every fast path: the law of docs/collision-law.md
 // evaluated in the world frame with plain 3x3 matrices (Iw^-1 = R diag(1/I) R^T),
-// one contact after another in input order, in a scalar type S. It is
+// one contact after another in input order (or in a solve's order), in a scalar type S. It is
 // instantiated for double, for long double (x87 extended, 64-bit mantissa),
 // the reference against which the fast kernels are measured, and for
 // __float128 where GCC has it (COLLIDE_HAS_FLOAT128), the one that judges
@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
@@ -49,24 +50,37 @@ struct ReferenceContact {
   S impulse_scale = 0;
 };
 
-/// Applies the law to every contact in input order. Writes J into `impulses`
-/// and updates v, w of the bodies. `diagnostics`, when not null, receives one
-/// entry per contact.
+/// The sequence in which a solve applies the law: the contacts in `order`
+/// (contact indices, each once: a solve's Schedule::order()), or in input
+/// order when it is null; `passes` times over, J summed over the passes
+/// (SolverOptions::passes).
+struct SolveSequence {
+  const std::uint32_t* order = nullptr;
+  std::size_t passes = 1;
+};
+
+/// Applies the law to every contact in `sequence` (input order by default).
+/// Writes J into `impulses` and updates v, w of the bodies. `diagnostics`,
+/// when not null, receives one entry per contact: the last pass's, with the
+/// impulse scales of all passes added up (J is their sum).
 template <class S>
 void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
-                     ReferenceContact<S>* diagnostics = nullptr);
+                     ReferenceContact<S>* diagnostics = nullptr, const SolveSequence& sequence = {});
 
 extern template void reference_solve<double>(const BodyView<double>&, const ContactView<double>&,
-                                             const ImpulseView<double>&, ReferenceContact<double>*);
+                                             const ImpulseView<double>&, ReferenceContact<double>*,
+                                             const SolveSequence&);
 extern template void reference_solve<long double>(const BodyView<long double>&, const ContactView<long double>&,
-                                                  const ImpulseView<long double>&, ReferenceContact<long double>*);
+                                                  const ImpulseView<long double>&, ReferenceContact<long double>*,
+                                                  const SolveSequence&);
 #if COLLIDE_HAS_FLOAT128
 // The reference's __float128 buffers are instantiated by collide::eval
 // (eval/src/quad_buffers.cpp), not by the core.
 extern template class BodyBuffer<__float128>;
 extern template class ContactBuffer<__float128>;
 extern template void reference_solve<__float128>(const BodyView<__float128>&, const ContactView<__float128>&,
-                                                 const ImpulseView<__float128>&, ReferenceContact<__float128>*);
+                                                 const ImpulseView<__float128>&, ReferenceContact<__float128>*,
+                                                 const SolveSequence&);
 #endif
 
 /// The same transcription of the law without the error analysis, in the

@@ -1,0 +1,208 @@
+// run_schedule.cpp - the walk of run_schedule.hpp.
+#include "run_schedule.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+
+#include <oneapi/tbb/task_group.h>
+
+#include "run_pipeline.hpp"
+
+namespace collide::detail {
+namespace {
+
+/// Fewest contacts an item of a split batch gets: a hand-over between
+/// threads costs about what the kernel spends on a few dozen contacts.
+constexpr std::size_t kMinItem = 64;
+
+/// One step of the walk: batches [first_batch, end_batch) of pass `pass`,
+/// which are items [first_item, first_item + items) of the walk.
+struct Step {
+  std::size_t pass = 0;
+  std::size_t first_batch = 0;
+  std::size_t end_batch = 0;
+  std::uint64_t first_item = 0;
+  std::size_t items = 0;  // > 1: one batch split; 1: a serial step
+};
+
+template <class T>
+class Walk {
+ public:
+  Walk(const KernelTable& table, const WalkPlan& plan, int threads, const KernelJob<T>& job, const Schedule& schedule)
+      : plan_(plan),
+        threads_(threads),
+        schedule_(schedule),
+        kernel_(plan.simd ? of_precision<T>(table.simd_float, table.simd_double) : &solve_range_scalar<T>),
+        run_kernel_(of_precision<T>(table.run_float, table.run_double)),
+        run_geometry_(of_precision<T>(table.run_geometry_float, table.run_geometry_double)),
+        run_walk_(of_precision<T>(table.run_walk_float, table.run_walk_double)),
+        first_(job),
+        later_(job) {
+    later_.accumulate = true;
+  }
+
+  /// What every thread of the walk does: claims items in order and runs
+  /// each once the steps before it are done; returns when all have finished.
+  void work() {
+    Step step;  // the empty step before the first
+    for (;;) {
+      const std::uint64_t item = claimed_.fetch_add(1, std::memory_order_relaxed);
+      while (item >= step.first_item + step.items) {
+        if (!next_step(step)) {
+          wait_for(step.first_item + step.items);
+          return;
+        }
+      }
+      wait_for(step.first_item);
+      run_item(step, static_cast<std::size_t>(item - step.first_item));
+      finished_.fetch_add(1, std::memory_order_acq_rel);
+    }
+  }
+
+ private:
+  [[nodiscard]] std::size_t size(std::size_t k) const {
+    return schedule_.batch_begin(k + 1) - schedule_.batch_begin(k);
+  }
+
+  /// The items a batch of n contacts splits into: blocks of plan.block
+  /// contacts, and at least one per thread once each gets kMinItem.
+  [[nodiscard]] std::size_t items_of(std::size_t n) const {
+    if (threads_ == 1 || n < 2 * kMinItem) return 1;
+    const std::size_t blocks = (n + plan_.block - 1) / plan_.block;
+    return std::max(blocks, std::min(static_cast<std::size_t>(threads_), n / kMinItem));
+  }
+
+  /// The step after `s`; false after the last.
+  bool next_step(Step& s) const {
+    std::size_t k = s.end_batch;
+    std::size_t pass = s.pass;
+    const std::size_t batches = schedule_.batch_count();
+    if (k == batches) {
+      if (++pass >= plan_.passes || batches == 0) return false;
+      k = 0;
+    }
+    Step next;
+    next.pass = pass;
+    next.first_batch = k;
+    next.first_item = s.first_item + s.items;
+    next.items = items_of(size(k));
+    next.end_batch = k + 1;
+    if (next.items == 1) {
+      while (next.end_batch < batches && items_of(size(next.end_batch)) == 1) ++next.end_batch;
+    }
+    s = next;
+    return true;
+  }
+
+  void run_item(const Step& s, std::size_t item) {
+    const KernelJob<T>& job = s.pass == 0 ? first_ : later_;
+    if (s.items == 1) {
+      run_serial(job, s.first_batch, s.end_batch);
+      return;
+    }
+    const std::size_t k = s.first_batch;
+    const std::size_t begin = schedule_.batch_begin(k);
+    const std::size_t end = schedule_.batch_begin(k + 1);
+    const std::size_t w = plan_.width;
+    const std::size_t per_item = ((end - begin + s.items - 1) / s.items + w - 1) / w * w;
+    const std::size_t b = begin + item * per_item;
+    if (b < end) kernel_(job, schedule_.batch_is_contiguous(k), b, std::min(end, b + per_item));
+  }
+
+  /// A contact or a few per batch: shorter than the lanes (SIMD), or every
+  /// batch of a serial step (the one-lane kernel walks contacts in order).
+  [[nodiscard]] bool runs_alone(std::size_t n) const { return !plan_.simd || n < plan_.width; }
+
+  /// Batches [k, end) in order on this thread. Stretches of batches that
+  /// run alone are one run, resolved contact after contact in the
+  /// schedule's order (the law's order; the run kernel keeps the one-lane
+  /// kernel's bits, kernel_isa.cpp, solve_run).
+  void run_serial(const KernelJob<T>& job, std::size_t k, std::size_t end) {
+    while (k < end) {
+      const std::size_t begin = schedule_.batch_begin(k);
+      std::size_t last = k + 1;
+      if (runs_alone(size(k))) {
+        while (last < end && runs_alone(size(last))) ++last;
+      }
+      const std::size_t stop = schedule_.batch_begin(last);
+      if (last == k + 1) {
+        kernel_(job, schedule_.batch_is_contiguous(k), begin, stop);
+      } else if (!plan_.simd) {
+        solve_range_scalar<T>(job, false, begin, stop);
+      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction &&
+                 stop - begin >= kPipelinedRunPieces * kRunPiece) {
+        run_pipelined(job, begin, stop);
+      } else {
+        run_kernel_(job, begin, stop);
+      }
+      k = last;
+    }
+  }
+
+  /// A long run, its pieces' geometry formed by the threads waiting for it.
+  void run_pipelined(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
+    PipelinedRun<T> run(run_geometry_, run_walk_, job, begin, end);
+    run_.store(&run, std::memory_order_seq_cst);
+    run.walk();
+    run_.store(nullptr, std::memory_order_seq_cst);
+    SpinWait wait;
+    while (helping_.load(std::memory_order_seq_cst) != 0) wait.pause();
+  }
+
+  /// Waits until `items` items have finished, helping a pipelined run meanwhile.
+  void wait_for(std::uint64_t items) {
+    SpinWait wait;
+    while (finished_.load(std::memory_order_acquire) < items) {
+      if (run_.load(std::memory_order_relaxed) != nullptr) {
+        helping_.fetch_add(1, std::memory_order_seq_cst);
+        if (PipelinedRun<T>* run = run_.load(std::memory_order_seq_cst)) run->help();
+        helping_.fetch_sub(1, std::memory_order_seq_cst);
+      }
+      wait.pause();
+    }
+  }
+
+  const WalkPlan& plan_;
+  const int threads_;
+  const Schedule& schedule_;
+  const RangeKernel<T> kernel_;
+  const RunKernel<T> run_kernel_;
+  const RunGeometryKernel<T> run_geometry_;
+  const RunWalkKernel<T> run_walk_;
+  KernelJob<T> first_;  // the first pass: J written
+  KernelJob<T> later_;  // the passes after: J added
+  std::atomic<std::uint64_t> claimed_{0};
+  std::atomic<std::uint64_t> finished_{0};
+  std::atomic<PipelinedRun<T>*> run_{nullptr};
+  std::atomic<int> helping_{0};
+};
+
+}  // namespace
+
+template <class T>
+void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena, const KernelJob<T>& job,
+                   const Schedule& schedule) {
+  arena.execute([&] {
+    const int threads = std::max(1, arena.max_concurrency());
+    Walk<T> walk(table, plan, threads, job, schedule);
+    if (threads == 1) {
+      walk.work();
+      return;
+    }
+    // The other threads are tasks of the arena: one that starts late finds
+    // its items claimed, and one that never starts is run by wait() once
+    // every item is done, and returns at once.
+    tbb::task_group helpers;
+    for (int t = 1; t < threads; ++t) helpers.run([&walk] { walk.work(); });
+    walk.work();
+    helpers.wait();
+  });
+}
+
+template void walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&, const KernelJob<float>&,
+                                   const Schedule&);
+template void walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&, const KernelJob<double>&,
+                                    const Schedule&);
+
+}  // namespace collide::detail

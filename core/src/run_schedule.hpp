@@ -1,0 +1,58 @@
+// run_schedule.hpp - a solve's walk over its schedule: the batches in order,
+// each on the threads of the solve's arena, pass after pass (private to the
+// library; the driver's, compiled for the baseline).
+//
+// Design notes
+// ------------
+// * The walk is data: a sequence of steps that every thread derives from
+//   the schedule alone, in the same order. A batch large enough to split is
+//   a parallel step of several items (ranges of its contacts, a multiple of
+//   the lane width each); a stretch of consecutive batches too small to split
+//   is one serial step, run by one thread in the schedule's order with no
+//   hand-off between its batches (in it, a stretch of batches smaller than
+//   the lanes is a run, resolved contact after contact by the run kernel).
+//   Items are numbered across the steps and passes.
+// * The threads of the arena start once per solve and claim items from one
+//   counter, in order. Before it runs an item, a thread waits until every
+//   item of the earlier steps has finished: a second counter, which only
+//   ever counts items of steps no later than the earliest unfinished one, so
+//   reaching the step's first item number means the steps before are done
+//   (Box2D's stage counter, b2ExecuteMainStage, does the same with a stage
+//   index). A thread that waits and finds a pipelined run in progress forms
+//   its geometry (run_pipeline.hpp) instead of spinning.
+// * Nothing depends on which thread runs what: the contacts of a batch share
+//   no movable body, so splitting a batch differently cannot change a bit,
+//   and a thread that never arrives (the arena busy elsewhere) leaves its
+//   items to the others.
+#pragma once
+
+#include <cstddef>
+
+#include <oneapi/tbb/task_arena.h>
+
+#include "collide/schedule.hpp"
+#include "kernel_table.hpp"
+
+namespace collide::detail {
+
+/// How a solve walks its schedule.
+struct WalkPlan {
+  bool simd = true;        ///< the SIMD kernels of the table, else the one-lane kernel
+  std::size_t width = 1;   ///< lanes of the kernel that runs
+  std::size_t block = 1;   ///< contacts per item of a large batch (a multiple of width)
+  std::size_t passes = 1;  ///< times the schedule is walked; J is summed over them
+};
+
+/// Resolves every contact of `schedule` `plan.passes` times with `job`'s
+/// kernels from `table`, on the threads of `arena`. The first pass writes J,
+/// the later ones add to it.
+template <class T>
+void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena, const KernelJob<T>& job,
+                   const Schedule& schedule);
+
+extern template void walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                          const KernelJob<float>&, const Schedule&);
+extern template void walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                           const KernelJob<double>&, const Schedule&);
+
+}  // namespace collide::detail

@@ -1,0 +1,32 @@
+// schedule_input.hpp - what the passes of a schedule read (private to the
+// library): the contacts' body indices and the bodies' inverse masses,
+// whatever the body layout.
+#pragma once
+
+#include <cstddef>
+
+#include "collide/bodies.hpp"
+#include "collide/contacts.hpp"
+
+namespace collide::detail {
+
+/// The contacts a pass reads: their body indices, and the body count every
+/// index must stay below.
+struct ContactIndices {
+  const BodyIndex* a = nullptr;
+  const BodyIndex* b = nullptr;
+  std::size_t count = 0;
+  std::size_t body_count = 0;
+};
+
+/// Body i's inverse mass at data[i * stride]: 1 for SoA views and a rigid
+/// packed view's dense array, the record size for other packed views.
+template <class T>
+struct InverseMasses {
+  const T* data = nullptr;
+  std::size_t stride = 1;
+
+  [[nodiscard]] bool immovable(std::size_t i) const { return is_immovable(data[i * stride]); }
+};
+
+}  // namespace collide::detail

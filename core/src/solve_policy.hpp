@@ -1,0 +1,49 @@
+// solve_policy.hpp - what a solve decides before it runs (private to the
+// library): the instruction set whose kernel runs, and whether SoA input is
+// packed first. Both follow from the scene's shape alone; neither changes a
+// bit of the result.
+#pragma once
+
+#include <cstddef>
+
+#include "collide/schedule.hpp"
+#include "collide/solve.hpp"
+#include "kernel_table.hpp"
+
+namespace collide::detail {
+
+/// How a Solver with `requested` picks its ISA: forced (a named ISA),
+/// environment (automatic and COLLIDE_ISA names one; "auto" there is the same
+/// as unset) or measured per solve.
+IsaChoice isa_choice_for(Isa requested);
+
+/// The table of a fixed choice (resolve_isa checks the CPU and reads
+/// COLLIDE_ISA, throwing for an unknown or unsupported ISA); none when the
+/// choice is measured per solve.
+const KernelTable* fixed_kernels(Isa requested, IsaChoice choice);
+
+/// The kernels of one solve and how they were chosen.
+struct IsaPick {
+  const KernelTable* kernels;
+  IsaChoice choice;
+  double calibration_seconds;  ///< spent measuring by this solve (SolveStats::isa_calibration_seconds)
+};
+
+/// The ISA of a solve of `model` in T: the fixed one, or the fastest for the
+/// solve's kind (measured on first use; scattered when most of its contacts
+/// are, scattered_contacts). The scalar path runs the baseline's one-lane
+/// kernel whatever the choice, and measures nothing.
+template <class T>
+IsaPick pick_isa(const SolverOptions& options, IsaChoice choice, const KernelTable* fixed, Model model,
+                 std::size_t scattered, std::size_t contacts);
+
+/// Contacts of the schedule that reach their bodies at random: those of
+/// batches that are not consecutive contacts, and those of consecutive
+/// batches whose bodies, sampled, do not follow one another.
+std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b);
+
+/// Whether SoA input of `bodies` bodies, `scattered` of whose contacts reach
+/// them at random, is packed (BodyLayout::automatic), or what `layout` forces.
+bool should_pack(BodyLayout layout, std::size_t scattered, std::size_t bodies);
+
+}  // namespace collide::detail
