@@ -12,6 +12,10 @@
 //                                    every ISA the CPU has, and Isa::automatic,
 //                                    at 64Ki (t:1) and 4Mi (t:2)
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
+//   then, at 64Ki and 4Mi in float, for pairs, debris, pile, pile+shuffle and chain:
+//     schedule/<scene>/f32/colour/n:N     Schedule::build in the colour order
+//     order/<scene>/f32/<input|colour>/passes:{1,4}/t:{1,2}/n:N   a solve in
+//                                    that order; the rate counts every pass
 //   then the piles' groups (pile, pile+shuffle) at the largest pile within
 //   each target size, and the chain's (float only, at the target sizes: one
 //   batch per contact, the law sequential through the row)
@@ -182,6 +186,27 @@ void register_rows(const Options& options, std::size_t file_contacts) {
   for (std::size_t n : options.sizes) {
     if (is_target_size(n)) {
       register_group<float>(Kind::chain, n);
+    }
+  }
+
+  // Both solve orders, with one pass and four per schedule, in float on the
+  // scenes with shared bodies and on pairs, at the target sizes: the colour
+  // order's rates against the input order's and against pairs. The colour
+  // schedule's build beside them.
+  for (std::size_t n : options.sizes) {
+    if (n != kCacheN && n != kStreamN) continue;
+    for (const Kind kind : {Kind::pairs, Kind::debris, Kind::pile, Kind::pile_shuffled, Kind::chain}) {
+      const std::size_t size = is_pile(kind) ? pile_size(n) : n;
+      add_row(schedule_name(kind, "f32", size, collide::Order::colour),
+              [=](benchmark::State& s) { schedule_row<float>(s, kind, size, collide::Order::colour); });
+      for (const collide::Order order : {collide::Order::input, collide::Order::colour}) {
+        for (const int passes : {1, 4}) {
+          for (const int threads : {1, 2}) {
+            add_row(order_name(kind, "f32", order, passes, threads, size),
+                    [=](benchmark::State& s) { order_row<float>(s, kind, size, order, passes, threads); });
+          }
+        }
+      }
     }
   }
 

@@ -60,8 +60,14 @@ std::string textbook_name(Kind kind, const char* precision, std::size_t n) {
   return std::string("textbook/") + kind_name(kind) + "/" + precision + threads_and_n(1, n);
 }
 
-std::string schedule_name(Kind kind, const char* precision, std::size_t n) {
-  return std::string("schedule/") + kind_name(kind) + "/" + precision + "/n:" + std::to_string(n);
+std::string schedule_name(Kind kind, const char* precision, std::size_t n, collide::Order order) {
+  return std::string("schedule/") + kind_name(kind) + "/" + precision +
+         (order == collide::Order::colour ? "/colour" : "") + "/n:" + std::to_string(n);
+}
+
+std::string order_name(Kind kind, const char* precision, collide::Order order, int passes, int threads, std::size_t n) {
+  return std::string("order/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(order) +
+         "/passes:" + std::to_string(passes) + threads_and_n(threads, n);
 }
 
 }  // namespace collide_bench

@@ -12,6 +12,7 @@
 
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
+#include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "scenes.hpp"
 
@@ -53,6 +54,10 @@ std::string packed_twin_name(Kind kind, collide::Model model, const char* precis
 /// textbook/<scene>/<precision>/t:1/n:N
 std::string textbook_name(Kind kind, const char* precision, std::size_t n);
 /// schedule/<scene>/<precision>/n:N
-std::string schedule_name(Kind kind, const char* precision, std::size_t n);
+std::string schedule_name(Kind kind, const char* precision, std::size_t n,
+                          collide::Order order = collide::Order::input);
+/// "order/<scene>/<prec>/<input|colour>/passes:P/t:T/n:N": a solve in that
+/// order with P passes per schedule.
+std::string order_name(Kind kind, const char* precision, collide::Order order, int passes, int threads, std::size_t n);
 
 }  // namespace collide_bench

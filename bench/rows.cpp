@@ -258,13 +258,13 @@ void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
 }
 
 template <class T>
-void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
+void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order) {
   Prepared<T>& p = prepared_scene<T>(kind, n);
   const collide::BodyView<T> bodies = p.bodies();
   const collide::ContactView<T> contacts = p.contacts();
   // A schedule of its own, built once untimed: later builds reuse its buffers,
   // as a simulation that rebuilds every frame does.
-  collide::Schedule schedule;
+  collide::Schedule schedule(order);
   schedule.build(contacts, bodies);
   const double seconds = time_iterations(state, [&] { schedule.build(contacts, bodies); });
   Columns columns;
@@ -275,6 +275,34 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
   set_counters(state, columns);
 }
 
+template <class T>
+void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads) {
+  Prepared<T>& p = prepared_scene<T>(kind, n);
+  measure_isa_auto<T>(collide::Model::rigid);
+  collide::SolverOptions options;
+  options.threads = threads;
+  options.order = order;
+  options.passes = passes;
+  const collide::Solver solver(options);
+  collide::Schedule schedule(order);  // untimed: a schedule serves every frame while the contacts hold
+  const collide::BodyView<T> bodies = p.bodies();
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  schedule.build(contacts, bodies, threads);
+  // One untimed solve sizes the solver's buffers (packing), as a frame loop's first frame does.
+  p.reset_for_solve();
+  solver.solve(bodies, contacts, impulses, schedule);
+  collide::SolveStats stats;
+  const double seconds = timed_solves(state, p, [&] { stats = solver.solve(bodies, contacts, impulses, schedule); });
+  Columns columns =
+      solve_columns(n * static_cast<std::size_t>(passes), bytes_per_collision<T>(p.friction), seconds, threads);
+  columns.batches = static_cast<double>(stats.batches);
+  columns.schedule_bytes_per_contact = static_cast<double>(schedule.memory_bytes()) / static_cast<double>(n);
+  set_counters(state, columns);
+  state.SetLabel(std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) + ", " +
+                 std::to_string(stats.colours) + " colours, " + std::to_string(stats.overflow_contacts) + " overflow");
+}
+
 #define COLLIDE_BENCH_ROWS(T)                                                                                     \
   template void solve_row<T>(benchmark::State&, Kind, std::size_t, Path, int, collide::Isa);                      \
   template void model_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int, collide::Accuracy); \
@@ -282,7 +310,8 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n) {
   template void twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int);                     \
   template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
   template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
-  template void schedule_row<T>(benchmark::State&, Kind, std::size_t);
+  template void schedule_row<T>(benchmark::State&, Kind, std::size_t, collide::Order);                            \
+  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);
 COLLIDE_BENCH_ROWS(float)
 COLLIDE_BENCH_ROWS(double)
 #undef COLLIDE_BENCH_ROWS

@@ -43,8 +43,13 @@ void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide:
 template <class T>
 void textbook_row(benchmark::State& state, Kind kind, std::size_t n);
 
-/// schedule/ rows: Schedule::build alone.
+/// schedule/ rows: Schedule::build alone, in either order.
 template <class T>
-void schedule_row(benchmark::State& state, Kind kind, std::size_t n);
+void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order = collide::Order::input);
+
+/// order/ rows: the rigid model through Solver::solve (SIMD, Isa::automatic)
+/// in `order` with `passes` passes; the rate counts every pass's contacts.
+template <class T>
+void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads);
 
 }  // namespace collide_bench

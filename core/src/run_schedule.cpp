@@ -16,6 +16,13 @@ namespace {
 /// threads costs about what the kernel spends on a few dozen contacts.
 constexpr std::size_t kMinItem = 64;
 
+/// Most items per thread a batch splits into. Threads take items in turn,
+/// so small items would have each thread leap from stretch to stretch of
+/// the arrays, and the hardware's stream prefetchers restart at every leap:
+/// a few long items per thread stream, and still even out a thread that
+/// runs late.
+constexpr std::size_t kItemsPerThread = 4;
+
 /// One step of the walk: batches [first_batch, end_batch) of pass `pass`,
 /// which are items [first_item, first_item + items) of the walk.
 struct Step {
@@ -66,11 +73,13 @@ class Walk {
   }
 
   /// The items a batch of n contacts splits into: blocks of plan.block
-  /// contacts, and at least one per thread once each gets kMinItem.
+  /// contacts, at most kItemsPerThread per thread, and at least one per
+  /// thread once each gets kMinItem.
   [[nodiscard]] std::size_t items_of(std::size_t n) const {
     if (threads_ == 1 || n < 2 * kMinItem) return 1;
+    const auto threads = static_cast<std::size_t>(threads_);
     const std::size_t blocks = (n + plan_.block - 1) / plan_.block;
-    return std::max(blocks, std::min(static_cast<std::size_t>(threads_), n / kMinItem));
+    return std::max(std::min(blocks, kItemsPerThread * threads), std::min(threads, n / kMinItem));
   }
 
   /// The step after `s`; false after the last.

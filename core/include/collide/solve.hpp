@@ -56,11 +56,11 @@ struct SolverOptions {
   /// Worker threads; 0 means every hardware thread. Results do not depend on
   /// it. Must be 0 for a solver running in the caller's arena (collide/tbb.hpp).
   int threads = 0;
-  /// Contacts per parallel task inside a batch (rounded up to the lane
-  /// width). A batch of fewer than two blocks runs on the calling thread. A
-  /// task of 1024 contacts takes 10 to 50 us, far above TBB's per-task cost,
-  /// and lets the small batches of shared-body scenes (the debris scene's
-  /// batches are a few thousand contacts at 64k) still split across threads.
+  /// Contacts per range a thread takes inside a batch (rounded up to the lane
+  /// width), where the batch gives each thread at most four such ranges;
+  /// larger batches give each thread four longer ones, so that every range
+  /// streams. A batch of 128 contacts or more gives each thread at least one
+  /// range; a smaller one runs on one thread. Results do not depend on it.
   std::size_t block = 1024;
   /// Instruction set of the SIMD path (collide/isa.hpp). A named one, or the
   /// one COLLIDE_ISA names when this is automatic, is resolved when the
