@@ -141,7 +141,7 @@ struct Solver::Impl {
   /// `scattered` is the schedule's scattered contacts (scattered_contacts).
   template <class T>
   detail::IsaPick pick(Model model, std::size_t scattered, std::size_t contacts) const {
-    if (options.path == Path::scalar) return {&detail::kernel_table(Isa::sse2), IsaChoice::forced, 0.0};
+    if (options.path == Path::scalar) return {&detail::kernel_table(Isa::sse2), IsaChoice::baseline, 0.0};
     if (kernels != nullptr) return {kernels, isa_choice, 0.0};
     double spent = 0;
     const Isa isa = detail::measured_isa<T>(model, options.accuracy, 2 * scattered > contacts, &spent).fastest;
