@@ -224,7 +224,9 @@ def check_output(shown: list[str], actual: str) -> None:
 
 def sandbox(root: str, work: str, block: Block, collide: str | None, python_path: str | None) -> str:
     """A fresh directory laid out like a checkout with a build: the source
-    tree's entries linked, build/collide and build/python this build's."""
+    tree's entries linked (read, not written: every block that builds or
+    installs is marked not run), build/collide this build's tool, and, for a
+    block that names it, build/python a copy of this build's package."""
     name = re.sub(r"[^\w.-]", "_", block.where)
     d = os.path.join(work, name)
     shutil.rmtree(d, ignore_errors=True)
@@ -235,8 +237,10 @@ def sandbox(root: str, work: str, block: Block, collide: str | None, python_path
         os.symlink(os.path.join(root, entry), os.path.join(d, entry))
     if collide:
         os.symlink(collide, os.path.join(d, "build", "collide"))
-    if python_path:
-        os.symlink(python_path, os.path.join(d, "build", "python"))
+    if python_path and any("build/python" in line for line in block.lines):
+        # A copy: a command must not write into this build's own tree.
+        shutil.copytree(python_path, os.path.join(d, "build", "python"), symlinks=True,
+                        ignore=shutil.ignore_patterns("CMakeFiles", "*.cmake", "Makefile", "docs-*", "tmp"))
     return d
 
 
