@@ -352,8 +352,9 @@ def main() -> int:
                 run_python(block, cwd, env, args.python)
                 print(f"ran   {block.where} (python)", flush=True)
             ran.append(block)
+            shutil.rmtree(cwd, ignore_errors=True)  # a failed block's directory stays, to look into
         except (Mismatch, subprocess.TimeoutExpired) as e:
-            failures.append((block, str(e)))
+            failures.append((block, f"{e}\n(its directory: {cwd})"))
     for block in not_run:
         if args.kind == "sh":
             print(f"not run {block.where} ({block.language or 'text'}): {block.not_run}")
