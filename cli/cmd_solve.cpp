@@ -39,6 +39,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -77,9 +78,10 @@ const char* const kSolveUsage =
     "                        atomically; '-' (stdout), a device such as /dev/null\n"
     "                        or a FIFO is written in place\n"
     "  --out-impulses FILE   result impulses file, likewise (only one output may be '-')\n"
-    "  --format F            csv or npz for every file above (default: npz for a name\n"
-    "                        ending in .npz, the binary scene format, else csv);\n"
-    "                        inputs and outputs may differ\n"
+    "  --format F            csv or npz for all four files above, the inputs too\n"
+    "                        (default: each file by its name: npz, the binary scene\n"
+    "                        format, for a name ending in .npz, else csv; so CSV\n"
+    "                        inputs and binary outputs need only the .npz names)\n"
     "  --precision P         float or double (default: a binary scene's own, else\n"
     "                        double)\n"
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
@@ -253,6 +255,20 @@ int solve_scene(const SolveRequest& req) {
   return kExitOk;
 }
 
+/// Whether `path` is a regular file whose first line is the header of a
+/// bodies or contacts CSV file (what `--format npz` on CSV inputs reads).
+/// Devices and FIFOs are not read: their bytes would be gone.
+bool starts_with_a_csv_header(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  std::ifstream file(path, std::ios::binary);
+  std::string first;
+  if (!std::getline(file, first)) return false;
+  if (!first.empty() && first.back() == '\r') first.pop_back();
+  first += '\n';
+  return first == bodies_header() || first == contacts_header();
+}
+
 }  // namespace
 
 int run_solve(int argc, char** argv) {
@@ -302,6 +318,13 @@ int run_solve(int argc, char** argv) {
       req.bodies_format = req.contacts_format = req.out_bodies_format = req.out_impulses_format = f;
     } catch (const std::invalid_argument& e) {
       throw UsageError(std::string("--format: ") + e.what());
+    }
+    for (const std::string* input : {&req.bodies_path, &req.contacts_path}) {
+      if (req.bodies_format == SceneFormat::npz && starts_with_a_csv_header(*input)) {
+        throw UsageError("--format npz applies to the inputs too, and " + *input +
+                         " is CSV: drop --format and name the outputs .npz (each file's format then comes from its "
+                         "name)");
+      }
     }
   } else {
     req.bodies_format = scene_format_of(req.bodies_path);

@@ -1,6 +1,7 @@
 // cli/main.cpp - the `collide` command-line tool: dispatch and option parsing.
 //
-// Usage: collide <command> [options]; commands are `solve`, `gen` and `report`.
+// Usage: collide <command> [options]; commands are `solve`, `gen`, `convert` and
+// `report`.
 // Every error is one line on stderr starting with "collide: ", and the exit
 // code says which kind (see commands.hpp).
 #include <charconv>
@@ -26,8 +27,10 @@ const char* const kMainUsage =
     "commands:\n"
     "  solve   resolve the contacts of a scene: read its bodies and contacts files,\n"
     "          write the bodies with their new velocities and the impulses\n"
-    "  gen     write a random scene (pairs or debris) as bodies and contacts files\n"
-    "  convert convert a scene file between CSV and the binary format (.npz)\n"
+    "  gen     write a random scene (pairs, debris, pile or chain) as bodies and\n"
+    "          contacts files\n"
+    "  convert convert a bodies, contacts or impulses file between CSV and the\n"
+    "          binary format (.npz)\n"
     "  report  measure every variant's speed and error on millions of random\n"
     "          collisions: a table, and optionally JSON and a PNG plot\n"
     "\n"

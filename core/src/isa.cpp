@@ -34,6 +34,8 @@ const char* to_string(IsaChoice choice) {
       return "environment";
     case IsaChoice::measured:
       return "measured";
+    case IsaChoice::baseline:
+      return "baseline";
   }
   return "?";
 }

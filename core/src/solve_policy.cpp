@@ -35,7 +35,7 @@ const KernelTable* fixed_kernels(Isa requested, IsaChoice choice) {
 template <class T>
 IsaPick pick_isa(const SolverOptions& options, IsaChoice choice, const KernelTable* fixed, Model model,
                  std::size_t scattered, std::size_t contacts) {
-  if (options.path == Path::scalar) return {&kernel_table(Isa::sse2), IsaChoice::forced, 0.0};
+  if (options.path == Path::scalar) return {&kernel_table(Isa::sse2), IsaChoice::baseline, 0.0};
   if (fixed != nullptr) return {fixed, choice, 0.0};
   double spent = 0;
   const Isa isa = measured_isa<T>(model, options.accuracy, 2 * scattered > contacts, &spent).fastest;

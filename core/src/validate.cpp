@@ -484,7 +484,10 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
     }
   }
   if (!contacts.e && !(contacts.uniform_e >= T(0) && contacts.uniform_e <= T(1))) {
-    return fail("contacts", "uniform_e", 0, contacts.uniform_e, "must be in [0, 1]");
+    std::ostringstream s;  // one value for every contact: no element index
+    s.precision(9);
+    s << "contacts.uniform_e = " << contacts.uniform_e << ": must be in [0, 1]";
+    return fail_text(s.str());
   }
   return {};
 }

@@ -334,11 +334,55 @@ ContactBuffer<T> read_contacts(const std::string& path, std::size_t body_count) 
   return parse_contacts<T>(buf.view(), path, body_count);
 }
 
+template <class T>
+ImpulseBuffer<T> parse_impulses(std::string_view text, std::string_view file_name) {
+  const std::string file(file_name);
+  const std::string_view data = check_header(text, file, kImpulseColumns);
+  ImpulseBuffer<T> impulses;
+  ImpulseView<T> j;
+  auto prepare = [&](std::size_t rows) {
+    impulses.resize(rows);
+    j = impulses.view();
+  };
+  const auto store = [&](const T* v, std::size_t row) {
+    j.j.x[row] = v[0];
+    j.j.y[row] = v[1];
+    j.j.z[row] = v[2];
+  };
+  auto parse_row = [&](const std::array<std::string_view, 3>& f, std::size_t row, Failure& failure) {
+    T v[3];
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (!parse_value(f[k], v[k], failure.reason)) {
+        failure.column = k;
+        return false;
+      }
+    }
+    store(v, row);
+    return true;
+  };
+  auto fast_row = [&](const char* b, const char* e, std::size_t row) {
+    T v[3];
+    if (!fast_numbers<3>(b, e, v)) return false;
+    store(v, row);
+    return true;
+  };
+  parse_rows(data, file, kImpulseColumns, prepare, fast_row, parse_row);
+  return impulses;
+}
+
+template <class T>
+ImpulseBuffer<T> read_impulses(const std::string& path) {
+  const FileBuffer buf(path);
+  return parse_impulses<T>(buf.view(), path);
+}
+
 #define COLLIDE_CSV_READ_INSTANTIATE(T)                                                         \
   template BodyTable<T> parse_bodies<T>(std::string_view, std::string_view);                    \
   template BodyTable<T> read_bodies<T>(const std::string&);                                     \
   template ContactBuffer<T> parse_contacts<T>(std::string_view, std::string_view, std::size_t); \
-  template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);
+  template ContactBuffer<T> read_contacts<T>(const std::string&, std::size_t);                  \
+  template ImpulseBuffer<T> parse_impulses<T>(std::string_view, std::string_view);              \
+  template ImpulseBuffer<T> read_impulses<T>(const std::string&);
 
 COLLIDE_CSV_READ_INSTANTIATE(float)
 COLLIDE_CSV_READ_INSTANTIATE(double)

@@ -417,6 +417,24 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
   return out;
 }
 
+template <class T>
+ImpulseBuffer<T> load_impulses(const std::string& path, SceneFormat format) {
+  if (format == SceneFormat::csv) return read_impulses<T>(path);
+  const NpzArchive archive = NpzArchive::map(path);
+  const auto members = table_members(archive, kImpulseColumns, "impulses");
+  const NpyType precision = npz_scene_precision(archive);
+  ImpulseBuffer<T> out(members[0]->count);
+  const ImpulseView<T> j = out.view();
+  T* const into[3] = {j.j.x, j.j.y, j.j.z};
+  for (std::size_t k = 0; k < kImpulseColumns.size(); ++k) {
+    std::vector<T> owned;
+    bool in_place = false;
+    const T* column = real_column<T>(archive, *members[k], precision, owned, in_place);
+    std::copy(column, column + j.count, into[k]);
+  }
+  return out;
+}
+
 // ---------------------------------------------------------------------------
 // Writers
 // ---------------------------------------------------------------------------
@@ -497,6 +515,15 @@ void write_contacts(OutputFile& out, SceneFormat format, const ContactView<T>& c
   }
 }
 
+template <class T>
+void write_impulses(OutputFile& out, SceneFormat format, const ImpulseView<const T>& impulses) {
+  if (format == SceneFormat::npz) {
+    write_impulses_npz(out, impulses);
+  } else {
+    write_impulses(out, impulses);
+  }
+}
+
 #define COLLIDE_SCENE_NPZ_INSTANTIATE(T)                                                           \
   template class LoadedBodies<T>;                                                                  \
   template class LoadedContacts<T>;                                                                \
@@ -508,7 +535,9 @@ void write_contacts(OutputFile& out, SceneFormat format, const ContactView<T>& c
   template void write_body_table_npz<T>(OutputFile&, const BodyColumns<T>&);                       \
   template void write_contacts_npz<T>(OutputFile&, const ContactView<T>&);                         \
   template void write_body_table<T>(OutputFile&, SceneFormat, const BodyColumns<T>&);              \
-  template void write_contacts<T>(OutputFile&, SceneFormat, const ContactView<T>&);
+  template void write_contacts<T>(OutputFile&, SceneFormat, const ContactView<T>&);                \
+  template ImpulseBuffer<T> load_impulses<T>(const std::string&, SceneFormat);                     \
+  template void write_impulses<T>(OutputFile&, SceneFormat, const ImpulseView<const T>&);
 
 COLLIDE_SCENE_NPZ_INSTANTIATE(float)
 COLLIDE_SCENE_NPZ_INSTANTIATE(double)

@@ -46,6 +46,7 @@ __all__ = [
     "Reference",
     "Schedule",
     "Solver",
+    "Stats",
     "accurate_error_ulps",
     "error_bound_eps",
     "error_target_eps",
@@ -71,6 +72,17 @@ __all__ = [
 ]
 
 __version__ = "0.1.0"
+
+
+class Stats(dict):
+    """The statistics of a solve, as :func:`solve` and :meth:`Solver.solve`
+    return them: a dict with the keys of ``collide solve --stats``, shown one
+    key per line."""
+
+    __slots__ = ()
+
+    def __repr__(self):
+        return "Stats({" + ",\n       ".join(f"{k!r}: {v!r}" for k, v in self.items()) + "})"
 
 
 def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", order="input",
@@ -242,7 +254,7 @@ def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
     return _collide.from_physical(arr(m, 0), arr(inertia, 3), arr(q, 4), arr(p, 3), arr(v, 3), arr(w, 3), dt)
 
 
-def report(*, n=4_000_000, debris_n=None, pile_n=None, threads=(1, 2), sample=100_000, runs=5, seed=1, quick=False):
+def report(*, n=1_000_000, debris_n=None, pile_n=None, threads=(1, 2), sample=100_000, runs=3, seed=1, quick=False):
     """The rows of ``collide report`` as a list of dicts (speed and error of
     every variant on the pairs, debris and pile scenes; docs/report.md has the
     columns). Takes minutes with the defaults; ``quick=True`` for a smoke run."""

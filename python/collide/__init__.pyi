@@ -19,6 +19,9 @@ error_bound_eps: float
 error_target_eps: float
 accurate_error_ulps: float
 
+class Stats(dict[str, Any]):
+    """The statistics of a solve: a dict with the keys of `collide solve --stats`."""
+
 class Bodies:
     """N bodies over the caller's arrays (no copy): inv_mass (N,), inv_inertia,
     p, v, w (3, N), q (4, N) as (w, x, y, z); one dtype, C-contiguous."""
@@ -135,7 +138,7 @@ class Solver:
         out: FloatArray | None = None,
         check: bool = True,
         impacts: bool = True,
-    ) -> tuple[FloatArray, dict[str, Any]]: ...
+    ) -> tuple[FloatArray, Stats]: ...
 
 class Reference:
     """The long double reference of one scene (values rounded to float64)."""
@@ -160,7 +163,7 @@ def solve(
     out: FloatArray | None = None,
     check: bool = True,
     impacts: bool = True,
-) -> tuple[FloatArray, dict[str, Any]]: ...
+) -> tuple[FloatArray, Stats]: ...
 class Islands:
     """The islands of a scene: read-only uint32 views of the library's result."""
 
@@ -220,12 +223,12 @@ def from_physical(
 ) -> Bodies: ...
 def report(
     *,
-    n: int = 4000000,
+    n: int = 1000000,
     debris_n: int | None = None,
     pile_n: int | None = None,
     threads: Sequence[int] = (1, 2),
     sample: int = 100000,
-    runs: int = 5,
+    runs: int = 3,
     seed: int = 1,
     quick: bool = False,
 ) -> list[dict[str, Any]]: ...

@@ -3,6 +3,8 @@
 // a TypeError that names the array; lengths with a ValueError.
 #include "arrays.hpp"
 
+#include <algorithm>
+
 namespace collide::python {
 
 std::string text(const py::handle& h) { return py::str(h).cast<std::string>(); }
@@ -26,6 +28,30 @@ Dtype scene_dtype(const std::string& what, const py::handle& obj) {
   if (d.equal(py::dtype::of<float>())) return Dtype::f32;
   if (d.equal(py::dtype::of<double>())) return Dtype::f64;
   throw py::type_error(what + " has dtype " + text(d) + ", expected float32 or float64");
+}
+
+Dtype scene_dtype(const std::string& owner, std::initializer_list<std::pair<const char*, py::handle>> arrays) {
+  // The float32 and float64 arrays, in order; anything else is checked_array's to refuse.
+  std::vector<std::pair<const char*, Dtype>> floats;
+  for (const auto& [name, obj] : arrays) {
+    if (!py::isinstance<py::array>(obj)) continue;
+    const py::dtype d = py::reinterpret_borrow<py::array>(obj).dtype();
+    if (d.equal(py::dtype::of<float>())) floats.emplace_back(name, Dtype::f32);
+    if (d.equal(py::dtype::of<double>())) floats.emplace_back(name, Dtype::f64);
+  }
+  if (floats.empty()) return scene_dtype(owner + "." + arrays.begin()->first, arrays.begin()->second);
+  const auto f32 = static_cast<std::size_t>(
+      std::count_if(floats.begin(), floats.end(), [](const auto& f) { return f.second == Dtype::f32; }));
+  const std::size_t f64 = floats.size() - f32;
+  if (f32 == 0 || f64 == 0) return floats.front().second;
+  const Dtype scene = f32 > f64 ? Dtype::f32 : f64 > f32 ? Dtype::f64 : floats.front().second;
+  const auto odd = std::find_if(floats.begin(), floats.end(), [&](const auto& f) { return f.second != scene; });
+  const auto like = std::find_if(floats.begin(), floats.end(), [&](const auto& f) { return f.second == scene; });
+  const bool one_odd = std::min(f32, f64) == 1 && f32 != f64;
+  const std::string others = one_odd ? "every other array of " + owner : owner + "." + like->first;
+  throw py::type_error(owner + "." + odd->first + " has dtype " + dtype_name(odd->second) + ", expected " +
+                       dtype_name(scene) + " like " + others + ": one dtype per scene (" + owner + "." + odd->first +
+                       ".astype(numpy." + dtype_name(scene) + ") converts a copy)");
 }
 
 std::string shape_text(const py::array& a) {
@@ -65,7 +91,11 @@ py::array checked_array(const std::string& owner, const char* name, const py::ha
   const bool rows_contiguous = rows != 0 && a.shape(1) > 0 && a.strides(1) == item && a.strides(0) % item == 0 &&
                                a.strides(0) >= a.shape(1) * item;
   if ((a.flags() & py::array::c_style) == 0 && !rows_contiguous) {
-    throw py::type_error(what + " must be C-contiguous (numpy.ascontiguousarray makes a contiguous copy)");
+    throw py::type_error(what + " must be C-contiguous " +
+                         (must_write ? "(the solve writes into it in place: a contiguous copy, "
+                                       "numpy.ascontiguousarray, would receive the results instead, so pass that "
+                                       "copy and read the results from it)"
+                                     : "(numpy.ascontiguousarray makes a contiguous copy)"));
   }
   if ((a.flags() & py::detail::npy_api::NPY_ARRAY_ALIGNED_) == 0) throw py::type_error(what + " must be aligned");
   if (must_write && !writeable(a)) throw py::type_error(what + " must be writeable: the solve updates it in place");

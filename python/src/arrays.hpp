@@ -48,6 +48,14 @@ Dtype parse_dtype(const py::object& dtype);
 /// The dtype of a scene, from its first floating-point array `what`
 /// (TypeError when it is not an ndarray of float32 or float64).
 Dtype scene_dtype(const std::string& what, const py::handle& obj);
+/// The dtype of a scene whose floating-point arrays are `arrays` (name,
+/// object; None for an optional array not given): the one they share. When
+/// they differ, a TypeError naming the array that differs from the others
+/// and what the others are ("bodies.inv_mass has dtype float32, expected
+/// float64 like every other array of bodies"); with as many of each, the
+/// first array's dtype is the scene's. An array that is not an ndarray of
+/// float32 or float64 is left to checked_array's message.
+Dtype scene_dtype(const std::string& owner, std::initializer_list<std::pair<const char*, py::handle>> arrays);
 
 /// f(float{}) or f(double{}): a generic lambda instantiated for the values
 /// of the precision `d`.
@@ -63,7 +71,9 @@ std::string shape_text(const py::array& a);
 /// (or, for a (rows, N) array, each row contiguous with the rows one stride
 /// apart: what collide.load leaves in a mapped file), aligned, writeable
 /// when the solve writes it, of `rows` rows (0: 1-D). Throws TypeError
-/// naming it ("<owner>.<name>").
+/// naming it ("<owner>.<name>"); for an array the solve writes, the
+/// message says that a converted or contiguous copy would receive the
+/// results instead.
 py::array checked_array(const std::string& owner, const char* name, const py::handle& obj, const py::dtype& dtype,
                         const char* dtype_text, int rows, bool writeable);
 

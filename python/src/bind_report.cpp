@@ -111,9 +111,9 @@ py::list report_hard_py(std::size_t n, int runs) {
 }  // namespace
 
 void register_report(py::module_& m) {
-  m.def("report", &report_py, py::kw_only(), py::arg("n") = 4000000, py::arg("debris_n") = py::none(),
+  m.def("report", &report_py, py::kw_only(), py::arg("n") = 1000000, py::arg("debris_n") = py::none(),
         py::arg("pile_n") = py::none(), py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000,
-        py::arg("runs") = 5, py::arg("seed") = 1, py::arg("quick") = false);
+        py::arg("runs") = 3, py::arg("seed") = 1, py::arg("quick") = false);
   m.def("report_hard", &report_hard_py, py::kw_only(), py::arg("n") = 1000, py::arg("runs") = 5);
 }
 

@@ -22,9 +22,11 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "bindings.hpp"
@@ -38,7 +40,9 @@ namespace collide::python {
 Bodies::Bodies(const py::object& inv_mass_in, const py::object& inv_inertia_in, const py::object& q_in,
                const py::object& p_in, const py::object& v_in, const py::object& w_in) {
   const std::string owner = "bodies";
-  dtype = scene_dtype("bodies.inv_mass", inv_mass_in);
+  dtype = scene_dtype(
+      owner,
+      {{"inv_mass", inv_mass_in}, {"inv_inertia", inv_inertia_in}, {"q", q_in}, {"p", p_in}, {"v", v_in}, {"w", w_in}});
   const py::dtype dt = numpy_dtype(dtype);
   const char* dn = dtype_name(dtype);
   inv_mass = checked_array(owner, "inv_mass", inv_mass_in, dt, dn, 0, false);
@@ -64,7 +68,7 @@ Contacts::Contacts(const py::object& a_in, const py::object& b_in, const py::obj
   const py::dtype u32 = py::dtype::of<std::uint32_t>();
   a = checked_array(owner, "a", a_in, u32, "uint32", 0, false);
   b = checked_array(owner, "b", b_in, u32, "uint32", 0, false);
-  dtype = scene_dtype("contacts.c", c_in);
+  dtype = scene_dtype(owner, {{"c", c_in}, {"n", n_in}, {"e", e_in}, {"mu", mu_in}});
   const py::dtype dt = numpy_dtype(dtype);
   const char* dn = dtype_name(dtype);
   c = checked_array(owner, "c", c_in, dt, dn, 3, false);
@@ -166,8 +170,19 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
       defect = first_body_defect(columns);
     }
     if (defect) {
-      throw py::value_error(owner + ": body " + std::to_string(defect->row) + ", column '" +
-                            std::string(defect->defect.column) + "': " + defect->defect.reason);
+      // What fixes a zero mass or moment in physical units: inf is the
+      // immovable body, and the locked axis.
+      const std::string column(defect->defect.column);
+      const std::string& why = defect->defect.reason;
+      const auto ends_with = [&](std::string_view tail) {
+        return why.size() >= tail.size() && why.compare(why.size() - tail.size(), tail.size(), tail) == 0;
+      };
+      const bool zero = ends_with(" must be > 0, got 0") || ends_with(" must be > 0, got -0");
+      const std::string fix = !zero           ? ""
+                              : column == "m" ? " (an immovable body has m = inf)"
+                                              : " (a locked axis has moment inf)";
+      throw py::value_error(owner + ": body " + std::to_string(defect->row) + ", column '" + column +
+                            "': " + defect->defect.reason + fix);
     }
     const auto [inv_mass, inv_inertia] = inverse_arrays(columns, d);
     const auto copy = [&](std::size_t first, std::size_t rows) {
@@ -244,7 +259,11 @@ void register_scene(py::module_& m) {
       .def_readonly("v", &Bodies::v)
       .def_readonly("w", &Bodies::w)
       .def_property_readonly("dtype", [](const Bodies& b) { return numpy_dtype(b.dtype); })
-      .def("__len__", [](const Bodies& b) { return b.count; });
+      .def("__len__", [](const Bodies& b) { return b.count; })
+      .def("__repr__", [](const Bodies& b) {
+        return "collide.Bodies(" + std::to_string(b.count) + " bodies, " + dtype_name(b.dtype) +
+               ": inv_mass (N,), inv_inertia, p, v, w (3, N), q (4, N))";
+      });
 
   py::class_<Contacts>(m, "Contacts")
       .def(py::init<const py::object&, const py::object&, const py::object&, const py::object&, const py::object&,
@@ -259,7 +278,17 @@ void register_scene(py::module_& m) {
       .def_property_readonly("mu", [](const Contacts& c) { return c.mu ? py::object(*c.mu) : py::none(); })
       .def_readonly("uniform_e", &Contacts::uniform_e)
       .def_property_readonly("dtype", [](const Contacts& c) { return numpy_dtype(c.dtype); })
-      .def("__len__", [](const Contacts& c) { return c.count; });
+      .def("__len__", [](const Contacts& c) { return c.count; })
+      .def("__repr__", [](const Contacts& c) {
+        std::string e = "e per contact";
+        if (!c.e) {
+          char uniform[48];
+          std::snprintf(uniform, sizeof uniform, "uniform_e %.17g", c.uniform_e);
+          e = uniform;
+        }
+        return "collide.Contacts(" + std::to_string(c.count) + " contacts, " + dtype_name(c.dtype) + ", " + e + ", " +
+               (c.mu ? "mu per contact" : "frictionless") + ")";
+      });
 
   m.def("generate", &generate_py, py::arg("kind"), py::arg("n"), py::kw_only(), py::arg("seed") = 1,
         py::arg("model") = "rigid", py::arg("friction") = false, py::arg("shuffle") = false,

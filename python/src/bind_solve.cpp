@@ -186,7 +186,7 @@ struct PySolver {
     py::dict d =
         to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));
     if (!impacts) d["impacts"] = py::none();
-    return py::make_tuple(j, d);
+    return py::make_tuple(j, py::module_::import("collide").attr("Stats")(d));  // a dict, shown key by key
   }
 
   template <class B>

@@ -460,7 +460,7 @@ TEST_F(CliTest, StatsIsOneJsonObjectWithTheDocumentedFields) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
   for (const char* field : {"\"collisions\": 4", "\"kernel_seconds\"", "\"collisions_per_second\"",
                             "\"precision\": \"float\"", "\"threads\"", "\"model\": \"rigid\"", "\"path\": \"scalar\"",
-                            "\"lanes\": 1", "\"batches\"", "\"schedule_seconds\""}) {
+                            "\"lanes\": 1", "\"batches\"", "\"schedule_seconds\"", "\"isa_choice\": \"baseline\""}) {
     EXPECT_NE(r.err.find(field), std::string::npos) << field << " missing in " << r.err;
   }
   EXPECT_EQ(r.err.find("check"), std::string::npos) << "no check fields without --check";
@@ -838,6 +838,13 @@ TEST_F(CliTest, Help) {
     EXPECT_EQ(r.exit_code, 0) << args[0];
     EXPECT_NE(r.out.find("usage: collide"), std::string::npos) << r.out;
   }
+}
+
+TEST_F(CliTest, MainHelpNamesEveryScene) {
+  const RunResult r = run({"--help"});
+  ASSERT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("(pairs, debris, pile or chain)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bodies, contacts or impulses file"), std::string::npos) << r.out;
 }
 
 TEST_F(CliTest, UsageErrorsExitTwo) {

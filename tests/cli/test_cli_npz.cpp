@@ -12,6 +12,7 @@
 #include "collide/eval/error_bound.hpp"
 #include "collide/io/npz.hpp"
 #include "collide/io/scene_io.hpp"
+#include "collide/io/scene_npz.hpp"
 #include "support/mini_json.hpp"
 #include "support/run_cli.hpp"
 
@@ -180,6 +181,91 @@ TEST_F(CliNpzTest, ConvertIsExactBothWays) {
       EXPECT_EQ(slurp(csv2), slurp(csv)) << precision << " " << table;
     }
   }
+}
+
+// Without --precision: a binary file keeps its own precision, and its CSV
+// (the shortest text of each stored value) comes back in it, the same bytes.
+TEST_F(CliNpzTest, ConvertKeepsTheBinaryPrecisionThroughCsvByDefault) {
+  for (const char* precision : {"float", "double"}) {
+    ASSERT_EQ(run({"gen", "--debris", "5000", "--out", dir_.string(), "--format", "npz", "--precision", precision,
+                   "--friction"})
+                  .exit_code,
+              0);
+    for (const char* table : {"bodies", "contacts"}) {
+      SCOPED_TRACE(std::string(precision) + " " + table);
+      const std::string npz = path(std::string(table) + ".npz").string();
+      const std::string csv = path(std::string(table) + ".csv").string();
+      const std::string back = path(std::string(table) + "_back.npz").string();
+      ASSERT_EQ(run({"convert", "--in", npz, "--out", csv}).exit_code, 0);
+      const RunResult r = run({"convert", "--in", csv, "--out", back});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_EQ(slurp(back), slurp(npz));
+    }
+  }
+}
+
+// A CSV of short decimals, as written by hand (data/example): read exactly
+// in either precision, converted in double, as a solve reads it.
+TEST_F(CliNpzTest, ConvertKeepsAHandWrittenCsvInDouble) {
+  spit(path("c.csv"), "a,b,cx,cy,cz,nx,ny,nz,e,mu\n0,1,0.4,1.6,0,0,1,0,0.5,0.3\n1,2,0.25,-1,0,1,0,0,0.8,0\n");
+  ASSERT_EQ(run({"convert", "--in", path("c.csv").string(), "--out", path("c.npz").string()}).exit_code, 0);
+  EXPECT_EQ(collide::npz_scene_precision(collide::NpzArchive::map(path("c.npz").string())), NpyType::f8);
+  ASSERT_EQ(run({"convert", "--in", path("c.npz").string(), "--out", path("c2.csv").string()}).exit_code, 0);
+  EXPECT_EQ(slurp(path("c2.csv")), slurp(path("c.csv")));
+}
+
+// The impulses a solve writes, either way, exactly: binary -> CSV is what the
+// solve writes as CSV, and back the same bytes, in the file's own precision.
+TEST_F(CliNpzTest, ConvertConvertsAnImpulsesFile) {
+  for (const char* precision : {"float", "double"}) {
+    SCOPED_TRACE(precision);
+    ASSERT_EQ(run({"gen", "--pairs", "3000", "--out", dir_.string(), "--format", "npz", "--precision", precision,
+                   "--friction"})
+                  .exit_code,
+              0);
+    ASSERT_EQ(solve("bodies.npz", "contacts.npz", "ob.npz", "oj.npz").exit_code, 0);
+    ASSERT_EQ(solve("bodies.npz", "contacts.npz", "ob.csv", "oj_solve.csv").exit_code, 0);
+    const RunResult to_csv = run({"convert", "--in", path("oj.npz").string(), "--out", path("oj.csv").string()});
+    ASSERT_EQ(to_csv.exit_code, 0) << to_csv.err;
+    EXPECT_EQ(slurp(path("oj.csv")), slurp(path("oj_solve.csv")));
+    const RunResult back = run({"convert", "--in", path("oj.csv").string(), "--out", path("oj2.npz").string()});
+    ASSERT_EQ(back.exit_code, 0) << back.err;
+    EXPECT_EQ(slurp(path("oj2.npz")), slurp(path("oj.npz")));
+  }
+  // A bad impulses file is named with its line, row and column.
+  spit(path("bad.csv"), "jx,jy,jz\n1,2,3\n1,x,3\n");
+  const RunResult bad = run({"convert", "--in", path("bad.csv").string(), "--out", path("bad.npz").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("bad.csv:3: row 1, column 'jy'"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(path("bad.npz")));
+}
+
+// As `collide gen` creates its output directory, convert creates its
+// output's; bad input creates nothing.
+TEST_F(CliNpzTest, ConvertCreatesTheOutputsDirectory) {
+  spit(path("b.npz"), SmallScene().bodies_bytes());
+  const fs::path out = path("new/deeper/b.csv");
+  const RunResult r = run({"convert", "--in", path("b.npz").string(), "--out", out.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(slurp(out).substr(0, 2), "m,");
+  SmallScene bad;
+  bad.body[0][1] = -1;
+  spit(path("bad.npz"), bad.bodies_bytes());
+  EXPECT_EQ(run({"convert", "--in", path("bad.npz").string(), "--out", path("none/b.csv").string()}).exit_code, 1);
+  EXPECT_FALSE(fs::exists(path("none")));
+}
+
+// --format names every file, the inputs too: CSV inputs with --format npz
+// are refused with what to do instead, and the .npz names alone work.
+TEST_F(CliNpzTest, FormatNpzWithCsvInputsSaysWhatToDo) {
+  ASSERT_EQ(run({"gen", "--pairs", "100", "--out", dir_.string()}).exit_code, 0);
+  const RunResult r = solve("bodies.csv", "contacts.csv", "ob", "oj", {"--format", "npz"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--format npz applies to the inputs too"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("name the outputs .npz"), std::string::npos) << r.err;
+  const RunResult named = solve("bodies.csv", "contacts.csv", "ob.npz", "oj.npz");
+  ASSERT_EQ(named.exit_code, 0) << named.err;
+  EXPECT_EQ(slurp(path("oj.npz")).substr(0, 2), "PK");
 }
 
 TEST_F(CliNpzTest, BadValueNamesFileRowAndColumnAndWritesNothing) {

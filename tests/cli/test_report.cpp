@@ -15,11 +15,15 @@
 //     identical (the paths agree bit for bit), small drifts;
 //   * the PNG exists and starts with the PNG signature. gnuplot is a declared
 //     dependency, so without it this test fails rather than skips;
-//   * the table on stdout has a line per row; usage errors exit 2.
+//   * stdout is the summary: the speed-against-error frontier of each scene
+//     (the rows no other row of the scene beats on both), computed here again
+//     from the JSON, and where the JSON and the plot are; with --all (a
+//     smaller run of its own) a line per row; usage errors exit 2.
 //
 // The JSON is read with tests/support/mini_json.hpp (no JSON library is a
 // dependency of the project).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -105,18 +109,95 @@ bool is_kernel(const Json& row) {
   return v == "scalar" || v == "simd" || v == "accurate";
 }
 
-TEST_F(ReportRun, ExitsZeroAndPrintsTheTable) {
-  ASSERT_EQ(report_->result.exit_code, 0) << report_->result.err;
-  EXPECT_NE(report_->result.out.find("scene   fric variant"), std::string::npos) << report_->result.out;
-  EXPECT_NE(report_->result.out.find("wall time"), std::string::npos);
-  ASSERT_EQ(report_->json.kind, Json::object);
-  // One table line per row: every row's variant and model appear in order.
-  std::size_t lines = 0;
-  std::istringstream table(report_->result.out);
+/// The row lines of a printed table (they start with the scene's name), as
+/// "scene fric variant precision model thr isa": the table's fixed columns.
+std::vector<std::string> table_rows(const std::string& out) {
+  const auto field = [](const std::string& line, std::size_t at, std::size_t width) {
+    std::string f = line.substr(at, width);
+    while (!f.empty() && f.back() == ' ') f.pop_back();
+    return f;
+  };
+  std::vector<std::string> rows;
+  std::istringstream table(out);
   for (std::string line; std::getline(table, line);) {
-    if (line.rfind("pairs ", 0) == 0 || line.rfind("debris ", 0) == 0 || line.rfind("pile ", 0) == 0) ++lines;
+    if (line.rfind("pairs ", 0) != 0 && line.rfind("debris ", 0) != 0 && line.rfind("pile ", 0) != 0) continue;
+    if (line.size() < 62) continue;
+    // %-7s %-4s %-9s %-11s %-8s %-6s %-6s %3d (report_table.cpp)
+    rows.push_back(field(line, 0, 7) + " " + field(line, 8, 4) + " " + field(line, 13, 9) + " " + field(line, 23, 11) +
+                   " " + field(line, 35, 8) + " " + std::to_string(std::stoi(line.substr(58, 3))) + " " +
+                   field(line, 44, 6));
   }
-  EXPECT_EQ(lines, rows().size());
+  return rows;
+}
+
+std::string row_key_text(const Json& row) {
+  return row.at("scene").str + " " + (row.at("friction").b ? "mu" : "-") + " " + row.at("variant").str + " " +
+         row.at("precision").str + " " + row.at("model").str + " " +
+         std::to_string(static_cast<int>(row.at("threads").num)) + " " + row.at("isa").str;
+}
+
+TEST_F(ReportRun, ExitsZeroAndPrintsTheFrontier) {
+  ASSERT_EQ(report_->result.exit_code, 0) << report_->result.err;
+  const std::string& out = report_->result.out;
+  EXPECT_NE(out.find("scene   fric variant"), std::string::npos) << out;
+  EXPECT_NE(out.find("wall time"), std::string::npos);
+  ASSERT_EQ(report_->json.kind, Json::object);
+  // Where the rest is: --all, the JSON and the plot this run wrote.
+  EXPECT_NE(out.find("every row: collide report --all; as JSON: " + (report_->dir / "report.json").string() +
+                     "; the plot: " + (report_->dir / "report.png").string()),
+            std::string::npos)
+      << out;
+  // The frontier, again from the JSON: of each scene and friction setting,
+  // the rows (kernel rows at the largest thread count) that no other beats,
+  // faster at no more error (max_err_eps x eps) or less error at no less
+  // speed; fastest first.
+  int most_threads = 1;
+  for (const Json& r : rows()) most_threads = std::max(most_threads, static_cast<int>(r.at("threads").num));
+  const auto candidate = [&](const Json& r) { return !is_kernel(r) || r.at("threads").num == most_threads; };
+  const auto error = [](const Json& r) { return r.at("max_err_eps").num * r.at("eps").num; };
+  const auto speed = [](const Json& r) { return r.at("collisions_per_second").num; };
+  std::map<std::string, std::vector<const Json*>> groups;
+  std::vector<std::string> group_order;
+  for (const Json& r : rows()) {
+    const std::string g = r.at("scene").str + (r.at("friction").b ? " mu" : " -");
+    if (groups.count(g) == 0) group_order.push_back(g);
+    groups[g].push_back(&r);
+  }
+  std::vector<std::string> expected;
+  for (const std::string& g : group_order) {
+    std::vector<const Json*> kept;
+    for (const Json* r : groups[g]) {
+      if (!candidate(*r)) continue;
+      bool beaten = false;
+      for (const Json* s : groups[g]) {
+        if (s == r || !candidate(*s)) continue;
+        beaten |=
+            (speed(*s) > speed(*r) && error(*s) <= error(*r)) || (speed(*s) >= speed(*r) && error(*s) < error(*r));
+      }
+      if (!beaten) kept.push_back(r);
+    }
+    std::stable_sort(kept.begin(), kept.end(), [&](const Json* a, const Json* b) { return speed(*a) > speed(*b); });
+    EXPECT_GE(kept.size(), 2U) << g << ": the fastest row and the most accurate one at least";
+    for (const Json* r : kept) expected.push_back(row_key_text(*r));
+  }
+  EXPECT_EQ(group_order.size(), 6U) << "pairs, debris and pile, with and without friction";
+  EXPECT_EQ(table_rows(out), expected) << out;
+  EXPECT_LT(expected.size(), rows().size() / 4) << "a summary";
+}
+
+// --all prints every row, one line each, in the JSON's order.
+TEST(ReportAll, PrintsEveryRow) {
+  const fs::path dir = fs::path(COLLIDE_TEST_TMP) / "report-all";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const RunResult r = run(dir, {"report", "--quick", "--n", "2000", "--threads", "1", "--runs", "1", "--all", "--json",
+                                (dir / "r.json").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json json = collide::test::JsonParser(slurp(dir / "r.json")).parse();
+  std::vector<std::string> expected;
+  for (const Json& row : json.at("rows").items) expected.push_back(row_key_text(row));
+  EXPECT_EQ(table_rows(r.out), expected) << r.out;
+  EXPECT_EQ(r.out.find("every row: collide report --all"), std::string::npos) << "the summary's pointer";
 }
 
 TEST_F(ReportRun, MachineFactsAreKnownOrUnknownNeverZero) {

@@ -191,7 +191,7 @@ TEST(IsaAuto, EnvironmentAndOptionsForceOne) {
     const IsaEnv env(nullptr);
     const SolveStats s = solve(options_for(Path::scalar, 1));
     EXPECT_EQ(s.isa, Isa::sse2);
-    EXPECT_EQ(s.isa_choice, IsaChoice::forced);
+    EXPECT_EQ(s.isa_choice, IsaChoice::baseline);
     EXPECT_EQ(s.lanes, 1u);
   }
 }

@@ -29,10 +29,48 @@ def make(arrays, carrays):
 def test_wrong_dtype(field):
     arrays, _ = scene()
     arrays[field] = arrays[field].astype(np.float32)
-    # inv_mass sets the scene's dtype: then the next array is the odd one.
-    name = "inv_inertia" if field == "inv_mass" else field
-    with pytest.raises(TypeError, match=rf"bodies\.{name} has dtype float(32|64), expected float"):
+    # The array that differs from the others is named, whichever it is.
+    with pytest.raises(TypeError, match=rf"^bodies\.{field} has dtype float32, expected float64 like every other "
+                                        rf"array of bodies: one dtype per scene \(bodies\.{field}\.astype"
+                                        r"\(numpy\.float64\) converts a copy\)$"):
         collide.Bodies(*(arrays[f] for f in FIELDS))
+
+
+@pytest.mark.parametrize("field", ["c", "n", "e", "mu"])
+def test_wrong_contact_dtype(field):
+    _, carrays = scene(np.float32)
+    carrays[field] = carrays[field].astype(np.float64)
+    with pytest.raises(TypeError, match=rf"^contacts\.{field} has dtype float64, expected float32 like every other "
+                                        r"array of contacts"):
+        collide.Contacts(carrays["a"], carrays["b"], carrays["c"], carrays["n"], e=carrays["e"], mu=carrays["mu"])
+    # Two arrays, one of each: the first one's dtype is the scene's.
+    with pytest.raises(TypeError, match=r"^contacts\.n has dtype float64, expected float32 like contacts\.c"):
+        collide.Contacts(carrays["a"], carrays["b"], carrays["c"].astype(np.float32), carrays["n"].astype(np.float64))
+
+
+def test_arrays_the_solve_writes_say_where_the_results_would_go():
+    arrays, carrays = scene()
+    bad = dict(arrays, v=np.asfortranarray(arrays["v"]))
+    with pytest.raises(TypeError, match=r"bodies\.v must be C-contiguous \(the solve writes into it in place: a "
+                                        r"contiguous copy, numpy\.ascontiguousarray, would receive the results "
+                                        r"instead"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+    b, c = make(arrays, carrays)
+    with pytest.raises(TypeError, match=r"solve\.out must be C-contiguous \(the solve writes into it in place"):
+        collide.solve(b, c, out=np.asfortranarray(np.zeros((3, len(c)))))
+    # An array the solve only reads: a copy is all it takes.
+    bad = dict(arrays, p=np.asfortranarray(arrays["p"]))
+    with pytest.raises(TypeError, match=r"bodies\.p must be C-contiguous \(numpy\.ascontiguousarray makes a "
+                                        r"contiguous copy\)$"):
+        collide.Bodies(*(bad[f] for f in FIELDS))
+
+
+def test_uniform_e_is_one_value_not_an_element():
+    arrays, carrays = scene()
+    b = collide.Bodies(*(arrays[f] for f in FIELDS))
+    c = collide.Contacts(carrays["a"], carrays["b"], carrays["c"], carrays["n"], uniform_e=-0.1)
+    with pytest.raises(ValueError, match=r"^contacts\.uniform_e = -0\.1: must be in \[0, 1\]$"):
+        collide.solve(b, c)
 
 
 def test_wrong_shape_and_layout():

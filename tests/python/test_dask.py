@@ -504,3 +504,33 @@ def test_import_collide_without_dask():
     lines = r.stdout.splitlines()
     assert lines[0] == "100 [0, 1, 1]"
     assert lines[1].startswith("ImportError: collide.dask needs distributed (Debian: python3-dask python3-distributed")
+
+
+def test_a_script_without_the_main_guard_runs_once(tmp_path):
+    # docs/distributed.md's call saved as a script, at its top level, without
+    # `if __name__ == "__main__":`. The cluster collide.dask starts for it
+    # runs in a process of its own, so its spawned workers never import the
+    # script: it runs once, finishes well within a minute, and gives
+    # collide.solve's bytes. (Started from the script's own process, every
+    # worker would run the script again and start a cluster, for ever.)
+    runs = tmp_path / "runs.txt"
+    script = tmp_path / "plain_script.py"
+    script.write_text(textwrap.dedent("""
+        import os
+        import numpy as np
+        import collide, collide.dask
+
+        with open(RUNS, "a") as f:
+            f.write(f"{os.getpid()}\\n")
+        bodies, contacts = collide.generate("pairs", 2000, friction=True, dtype=np.float32)
+        alone, _ = collide.generate("pairs", 2000, friction=True, dtype=np.float32)
+        expected, _ = collide.solve(alone, contacts)
+        J, v, w, stats = collide.dask.solve((bodies, contacts), workers=2)
+        assert J.tobytes() == expected.tobytes()
+        assert v.tobytes() == alone.v.tobytes() and w.tobytes() == alone.w.tobytes()
+        print("solved in", len(stats["partitions"]), "partitions")
+    """).replace("RUNS", repr(str(runs))))
+    r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout == "solved in 2 partitions\n", r.stdout
+    assert len(runs.read_text().split()) == 1, "the script ran again in a worker: " + runs.read_text()

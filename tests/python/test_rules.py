@@ -85,6 +85,11 @@ def reader_message(workdir, values, dtype):
     return str(e.value), b_csv
 
 
+# What from_physical adds to the reader's reason for a zero mass or moment:
+# what the caller most likely meant, in physical units.
+FIX = {"zero_m": " (an immovable body has m = inf)", "zero_moment": " (a locked axis has moment inf)"}
+
+
 @pytest.mark.parametrize("name,dtype,change,reason,column", CASES, ids=[c[0] for c in CASES])
 def test_from_physical_gives_the_readers_reason(workdir, name, dtype, change, reason, column):
     values = dict(GOOD, **change)
@@ -96,7 +101,7 @@ def test_from_physical_gives_the_readers_reason(workdir, name, dtype, change, re
     with pytest.raises(ValueError) as e:
         m_, inertia, q, p, v, w = physical_arrays(values, dtype)
         collide.from_physical(m_, inertia, q, p, v, w, dtype=dtype)
-    assert str(e.value) == f"from_physical: body 0, column '{column}': {reason}"
+    assert str(e.value) == f"from_physical: body 0, column '{column}': {reason}{FIX.get(name, '')}"
 
 
 def test_from_physical_names_the_body():
@@ -110,6 +115,10 @@ def test_from_physical_names_the_body():
         collide.from_physical(m, inertia, q, p)
     p[2, 1] = 0
     with pytest.raises(ValueError, match=r"^from_physical: body 3, column 'm': mass must be > 0, got -4$"):
+        collide.from_physical(m, inertia, q, p)
+    m[2] = 0.0  # the immovable body written as in kernel units: m = inf is the one
+    with pytest.raises(ValueError, match=r"^from_physical: body 2, column 'm': mass must be > 0, got 0 "
+                                         r"\(an immovable body has m = inf\)$"):
         collide.from_physical(m, inertia, q, p)
 
 

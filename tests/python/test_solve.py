@@ -196,6 +196,21 @@ def test_from_physical():
         collide.from_physical(np.array([-1.0]), np.ones((3, 1)), q[:, :1].copy(), np.zeros((3, 1)))
 
 
+def test_readable_reprs():
+    bodies, contacts = collide.generate("pairs", 10, friction=True, dtype=np.float32)
+    assert repr(bodies) == "collide.Bodies(20 bodies, float32: inv_mass (N,), inv_inertia, p, v, w (3, N), q (4, N))"
+    assert repr(contacts) == "collide.Contacts(10 contacts, float32, e per contact, mu per contact)"
+    plain = collide.Contacts(contacts.a, contacts.b, contacts.c, contacts.n, uniform_e=0.5)
+    assert repr(plain) == "collide.Contacts(10 contacts, float32, uniform_e 0.5, frictionless)"
+    # The stats: a dict, shown one key per line, that reads back as itself.
+    J, stats = collide.solve(bodies, contacts)
+    assert isinstance(stats, dict) and type(stats) is collide.Stats
+    text = repr(stats)
+    assert text.startswith("Stats({'collisions': 10,\n       'impacts': ")
+    assert len(text.splitlines()) == len(stats)
+    assert eval(text, {"Stats": collide.Stats}) == stats
+
+
 def test_report_quick_rows():
     rows = collide.report(n=2000, sample=500, runs=1, threads=[1], quick=True)
     assert rows and {"scene", "variant", "model", "precision", "max_err_eps", "collisions_per_second"} <= set(rows[0])

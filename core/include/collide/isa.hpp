@@ -60,12 +60,13 @@ Isa resolve_isa(Isa requested);
 
 /// How the ISA of a solve was chosen (SolveStats::isa_choice).
 enum class IsaChoice {
-  forced,       ///< SolverOptions::isa named it; also the scalar path, which always runs the baseline (sse2)
+  forced,       ///< SolverOptions::isa named it
   environment,  ///< SolverOptions::isa was automatic and COLLIDE_ISA named it
   measured,     ///< automatic with COLLIDE_ISA unset: fastest_isa() for the solve (collide/solve.hpp)
+  baseline,     ///< the scalar path, which runs the baseline's (sse2) one-lane kernel whatever was asked
 };
 
-/// "forced", "environment" or "measured".
+/// "forced", "environment", "measured" or "baseline".
 const char* to_string(IsaChoice choice);
 
 /// Lanes of the SIMD path for T (float or double) under a concrete ISA.

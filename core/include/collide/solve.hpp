@@ -192,8 +192,8 @@ class Solver {
   /// measured): each solve's SolveStats::isa says which ISA ran.
   [[nodiscard]] Isa isa() const;
   /// How the ISA of this solver's SIMD solves is chosen: forced,
-  /// environment or measured (SolveStats::isa_choice, which is forced on the
-  /// scalar path: it always runs the baseline).
+  /// environment or measured (SolveStats::isa_choice, which is baseline on
+  /// the scalar path: it always runs the baseline).
   [[nodiscard]] IsaChoice isa_choice() const;
 
   /// Resolves every contact: updates v and w of movable bodies and writes J.

@@ -155,17 +155,17 @@ struct Report {
 
 /// What to measure; the defaults are `collide report` without options.
 struct ReportOptions {
-  std::size_t n = 4000000;            ///< collisions of the pairs scene
+  std::size_t n = 1000000;            ///< collisions of the pairs scene
   std::vector<int> threads = {1, 2};  ///< thread counts of the kernel rows
   std::size_t sample = 100000;        ///< contacts of the error sample
-  int runs = 5;                       ///< timed runs per row (the median is reported)
+  int runs = 3;                       ///< timed runs per row (the median is reported)
   std::uint64_t seed = 1;             ///< scene seed
   bool quick = false;                 ///< a smoke run: short triad, sample of at most n
   std::size_t debris_n = 1000000;     ///< collisions of the debris scene
   /// Collisions of the pile scene (generate_pile): the largest cubic pile
   /// with at most this many contacts (1000000: 69^3 boxes, 976005 contacts).
   std::size_t pile_n = 1000000;
-  std::size_t slow_n = 500000;       ///< contacts of the slow (single-threaded, unvectorised) rows
+  std::size_t slow_n = 200000;       ///< contacts of the slow (single-threaded, unvectorised) rows
   std::vector<std::size_t> sweep_n;  ///< N of the throughput sweep; empty: no sweep
   /// The hard section: every scene of hard::hard_scene_catalogue() in float
   /// and double, fast and accurate, SIMD at one thread (`--hard`).
@@ -196,8 +196,19 @@ std::vector<HardRow> measure_hard_report(const ReportOptions& options);
 
 /// Puts the rows into the canonical order of the table and the JSON.
 void sort_report_rows(Report& report);
-/// The fixed-width table printed on stdout.
+/// The speed-against-error frontier of each scene and friction setting: the
+/// indices of the rows (in canonical order, see sort_report_rows) that no
+/// other row of the group beats, being faster at no more error or less
+/// erroneous at no less speed; error is max_err_eps x eps, kernel rows count
+/// at the largest thread count of the run. Group by group, fastest first.
+std::vector<std::size_t> report_frontier(const Report& report);
+/// The fixed-width table printed on stdout by `collide report --all`: every row.
 std::string format_report_table(const Report& report);
+/// What `collide report` prints by default: the run and the machine, the
+/// frontier rows (report_frontier), the hard section when measured, where
+/// every row is (`json_path`, `plot_path`: empty when not written) and the
+/// wall time.
+std::string format_report_summary(const Report& report, const std::string& json_path, const std::string& plot_path);
 /// The JSON document: {"machine": ..., "rows": [one object per row], "hard": [one object per
 /// hard row; empty without --hard], "sweep": [...]}.
 std::string format_report_json(const Report& report);

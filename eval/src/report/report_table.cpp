@@ -1,17 +1,20 @@
-// report/report_table.cpp - the fixed-width table `collide report` prints
-// on stdout (format_report_table): the run and the machine, one line per
-// row grouped by scene and friction, then the hard section, the sweep and
-// the wall time.
+// report/report_table.cpp - what `collide report` prints on stdout: by
+// default the summary (format_report_summary: the run and the machine, the
+// speed-against-error frontier of each scene, where the rest is), with
+// --all the whole table (format_report_table: one line per row grouped by
+// scene and friction, then the hard section, the sweep and the wall time).
 //
 // Design notes
 // ------------
 // * Written from the same Report as the JSON and the plot, rows already in
-//   the canonical order (report_order.cpp), so the three agree.
+//   the canonical order (report_order.cpp), so the three agree; the summary's
+//   lines are the table's lines of the frontier rows.
 // * A cache size that could not be read prints "unknown", not 0.
 #include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "collide/accuracy.hpp"
 #include "collide/eval/check.hpp"
@@ -32,9 +35,8 @@ std::string mib(std::size_t bytes) {
 /// A cache size that may be unknown: "unknown" in text, null in JSON.
 std::string mib(const std::optional<std::size_t>& bytes) { return bytes ? mib(*bytes) : "unknown"; }
 
-}  // namespace
-
-std::string format_report_table(const Report& report) {
+/// The run, the machine and the legend, up to the rows' header.
+std::string preamble(const Report& report) {
   const MachineInfo& m = report.machine;
   std::string out;
   char line[512];
@@ -94,13 +96,21 @@ std::string format_report_table(const Report& report) {
                 "(docs/report.md).\n\n",
                 kImpulseErrorBoundEps);
   out += line;
+  return out;
+}
 
-  const char* const header =
-      "scene   fric variant   precision   model    isa    layout thr         n  Mcoll/s     bw   max err   p99 err"
-      "   max rel       dP       dL       dE  note\n";
-  out += header;
+const char* const kRowHeader =
+    "scene   fric variant   precision   model    isa    layout thr         n  Mcoll/s     bw   max err   p99 err"
+    "   max rel       dP       dL       dE  note\n";
+
+/// The rows `which` (indices into report.rows), a blank line between scene
+/// and friction groups.
+std::string row_lines(const Report& report, const std::vector<std::size_t>& which) {
+  std::string out;
+  char line[512];
   std::string previous_group;
-  for (const ReportRow& r : report.rows) {
+  for (const std::size_t i : which) {
+    const ReportRow& r = report.rows[i];
     const std::string group = r.scene + (r.friction ? "1" : "0");
     if (!previous_group.empty() && group != previous_group) out += "\n";
     previous_group = group;
@@ -113,32 +123,62 @@ std::string format_report_table(const Report& report) {
         r.note.c_str());
     out += line;
   }
-  if (!report.hard.empty()) {
-    std::snprintf(
-        line, sizeof line,
-        "\nhard scenes (--hard; collide/eval/hard_scenes.hpp): %zu pairs per pair family, the shared scenes at "
-        "their sizes;\n"
-        "  simd, 1 thread, solved by the model each scene is shaped for; err in eps x impulse scale vs long "
-        "double\n"
-        "  (fast mode's target %.0f), ulps = max |J-Jref| / (eps |Jref|) vs the exact law (accurate mode's "
-        "bound %.0f;\n"
-        "  shared scenes: each contact on the state stored before it).\n",
-        report.hard_n, kImpulseErrorTargetEps, kAccurateErrorUlps);
+  return out;
+}
+
+/// The hard section (--hard), or nothing.
+std::string hard_lines(const Report& report) {
+  if (report.hard.empty()) return {};
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "\nhard scenes (--hard; collide/eval/hard_scenes.hpp): %zu pairs per pair family, the shared scenes at "
+                "their sizes;\n"
+                "  simd, 1 thread, solved by the model each scene is shaped for; err in eps x impulse scale vs long "
+                "double\n"
+                "  (fast mode's target %.0f), ulps = max |J-Jref| / (eps |Jref|) vs the exact law (accurate mode's "
+                "bound %.0f;\n"
+                "  shared scenes: each contact on the state stored before it).\n",
+                report.hard_n, kImpulseErrorTargetEps, kAccurateErrorUlps);
+  out += line;
+  out +=
+      "family             model    precision mode      isa      n    act  Mcoll/s   max err   p99 err     max ulps\n";
+  std::string previous;
+  for (const HardRow& h : report.hard) {
+    if (!previous.empty() && h.family != previous) out += "\n";
+    previous = h.family;
+    const std::string ulps = std::isnan(h.max_err_ulps) ? "n/a" : format("%.4g", h.max_err_ulps);
+    std::snprintf(line, sizeof line, "%-18s %-8s %-9s %-8s %-6s %6zu %6zu %8.2f %9.3g %9.3g %12s\n", h.family.c_str(),
+                  h.model.c_str(), h.precision.c_str(), h.mode.c_str(), h.isa.c_str(), h.n, h.acting,
+                  h.collisions_per_second / 1e6, h.max_err_eps, h.p99_err_eps, ulps.c_str());
     out += line;
-    out +=
-        "family             model    precision mode      isa      n    act  Mcoll/s   max err   p99 err     max ulps\n";
-    std::string previous;
-    for (const HardRow& h : report.hard) {
-      if (!previous.empty() && h.family != previous) out += "\n";
-      previous = h.family;
-      const std::string ulps = std::isnan(h.max_err_ulps) ? "n/a" : format("%.4g", h.max_err_ulps);
-      std::snprintf(line, sizeof line, "%-18s %-8s %-9s %-8s %-6s %6zu %6zu %8.2f %9.3g %9.3g %12s\n", h.family.c_str(),
-                    h.model.c_str(), h.precision.c_str(), h.mode.c_str(), h.isa.c_str(), h.n, h.acting,
-                    h.collisions_per_second / 1e6, h.max_err_eps, h.p99_err_eps, ulps.c_str());
-      out += line;
-    }
   }
+  return out;
+}
+
+/// "wall time 12.3 s (triad 1.0 s, ...)".
+std::string wall_line(const Report& report) {
+  char line[512];
+  std::snprintf(line, sizeof line, "\nwall time %.1f s (", report.wall_seconds);
+  std::string out = line;
+  for (std::size_t i = 0; i < report.phase_seconds.size(); ++i) {
+    std::snprintf(line, sizeof line, "%s%s %.1f s", i ? ", " : "", report.phase_seconds[i].first.c_str(),
+                  report.phase_seconds[i].second);
+    out += line;
+  }
+  return out + ")\n";
+}
+
+}  // namespace
+
+std::string format_report_table(const Report& report) {
+  std::string out = preamble(report) + kRowHeader;
+  std::vector<std::size_t> all(report.rows.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  out += row_lines(report, all);
+  out += hard_lines(report);
   if (!report.sweep.empty()) {
+    char line[512];
     out += "\nthroughput against N (pairs, simd float, frictionless):\n";
     out += "model         N  thr  runs  Mcoll/s     bw\n";
     for (const SweepPoint& p : report.sweep) {
@@ -147,15 +187,28 @@ std::string format_report_table(const Report& report) {
       out += line;
     }
   }
-  std::snprintf(line, sizeof line, "\nwall time %.1f s (", report.wall_seconds);
+  return out + wall_line(report);
+}
+
+std::string format_report_summary(const Report& report, const std::string& json_path, const std::string& plot_path) {
+  const std::vector<std::size_t> frontier = report_frontier(report);
+  std::string out = preamble(report);
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "speed against error: of each scene, the %zu of %zu rows that no other row beats on both (faster at "
+                "no more\nerror, or less error at no less speed; kernel rows at the largest thread count), fastest "
+                "first:\n\n",
+                frontier.size(), report.rows.size());
   out += line;
-  for (std::size_t i = 0; i < report.phase_seconds.size(); ++i) {
-    std::snprintf(line, sizeof line, "%s%s %.1f s", i ? ", " : "", report.phase_seconds[i].first.c_str(),
-                  report.phase_seconds[i].second);
-    out += line;
-  }
-  out += ")\n";
-  return out;
+  out += kRowHeader;
+  out += row_lines(report, frontier);
+  out += hard_lines(report);
+  out += "\nevery row: collide report --all";
+  out += json_path.empty() ? ", or --json FILE" : "; as JSON: " + json_path;
+  out += plot_path.empty() ? "; the plot: --plot FILE.png" : "; the plot: " + plot_path;
+  if (!report.sweep.empty()) out += " (with the throughput against N)";
+  out += "\n";
+  return out + wall_line(report);
 }
 
 }  // namespace collide

@@ -32,7 +32,7 @@ import numpy as np
 import collide
 
 from ._partition import partition_islands, single_contact_ends
-from . import _tasks
+from . import _cluster, _tasks
 
 __all__ = ["GIANT_ISLAND_SHARE", "IslandWarning", "SCENE_COLUMNS", "Solution", "partition_islands", "solve",
            "solve_scenes"]
@@ -75,7 +75,10 @@ def _connected(client, workers=None):
     """The client to run on: ``client`` itself, a new Client to a scheduler
     address, the default client of this process, or a new LocalCluster
     (``workers`` processes of one thread; all cores by default), closed
-    afterwards."""
+    afterwards. That cluster runs in a process of its own (_cluster.py), so
+    that its workers do not import the caller's script: a script that calls
+    collide.dask at its top level, without an ``if __name__ ==
+    "__main__":`` guard, runs as it does with one."""
     distributed = _need("distributed")
     if isinstance(client, distributed.Client):
         yield client
@@ -93,9 +96,8 @@ def _connected(client, workers=None):
     except ValueError:
         pass
     n = workers or os.cpu_count() or 1
-    with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        with distributed.Client(cluster) as c:
-            yield c
+    with _cluster.local_cluster(n) as address, distributed.Client(address) as c:
+        yield c
 
 
 def _wait(futures, progress, what):

@@ -211,6 +211,15 @@ ContactBuffer<T> parse_contacts(std::string_view text, std::string_view file_nam
 template <class T>
 ContactBuffer<T> read_contacts(const std::string& path, std::size_t body_count);
 
+/// Parses the text of an impulses file (header jx,jy,jz), as `collide solve`
+/// writes it: any value of T, NaN and inf included (no rule applies to a
+/// result).
+template <class T>
+ImpulseBuffer<T> parse_impulses(std::string_view text, std::string_view file_name);
+/// Reads and parses an impulses file.
+template <class T>
+ImpulseBuffer<T> read_impulses(const std::string& path);
+
 /// Reads a whole file into memory (also used by the CLI to compare files).
 std::string read_file(const std::string& path);
 

@@ -169,6 +169,11 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRul
 /// Reads a contacts file whose ids refer to `body_count` bodies.
 template <class T>
 LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std::size_t body_count);
+/// Reads an impulses file (what `collide solve --out-impulses` writes) in
+/// precision T: read_impulses for CSV; for binary, the members jx, jy, jz,
+/// copied (a double too large for float is refused, as in a scene file).
+template <class T>
+ImpulseBuffer<T> load_impulses(const std::string& path, SceneFormat format);
 
 // ---------------------------------------------------------------------------
 // Binary writers: the CSV writers' counterparts (collide/io/scene_io.hpp).
@@ -194,5 +199,8 @@ template <class T>
 void write_body_table(OutputFile& out, SceneFormat format, const BodyColumns<T>& table);
 template <class T>
 void write_contacts(OutputFile& out, SceneFormat format, const ContactView<T>& contacts);
+/// Writes an impulses file in either format.
+template <class T>
+void write_impulses(OutputFile& out, SceneFormat format, const ImpulseView<const T>& impulses);
 
 }  // namespace collide
