@@ -14,11 +14,20 @@ namespace {
 
 constexpr std::size_t kWindow = Schedule::kColourWindow;
 
-/// A body's table word: bit c for each colour c < kColours its earlier
-/// contacts of the window hold, and kImmovableBit for a body that joins none.
-constexpr std::uint32_t kImmovableBit = std::uint32_t{1} << kColours;
-constexpr std::uint32_t kColourBits = kImmovableBit - 1;
-static_assert(kColours == 31, "the colours and the immovable bit fill a 32-bit word");
+/// A body's table word: its tag in the top byte and, below, bit c for each
+/// colour c < kColours that its earlier contacts of the window hold. The
+/// tag says whose the bits are: the window's own tag (1 .. kLastTag, given
+/// to the windows a thread colours in turn) makes them the window's; any
+/// other tag means none; tag 0 marks an immovable body, which joins no
+/// colour and whose word is never written. So a window starts from clean
+/// words without a pass to clear them; only when a thread's tags wrap
+/// around is its table filled anew.
+constexpr unsigned kTagShift = 24;
+static_assert(kColours == kTagShift, "the colours fill the bits below the tag");
+constexpr std::uint32_t kColourBits = (std::uint32_t{1} << kTagShift) - 1;
+constexpr std::uint32_t kImmovableTag = 0;
+constexpr std::uint32_t kFreeTag = 0xFF;  // a movable body no window has tagged yet
+constexpr std::uint32_t kLastTag = 0xFE;
 
 /// The label of a contact in its window's overflow.
 constexpr std::uint8_t kOverflow = kColours;
@@ -27,11 +36,12 @@ constexpr std::uint8_t kOverflow = kColours;
 /// pass, level_pass.cpp).
 constexpr std::size_t kPrefetchDistance = 16;
 
-inline bool movable(std::uint32_t word) { return (word & kImmovableBit) == 0; }
+inline bool movable(std::uint32_t word) { return (word >> kTagShift) != kImmovableTag; }
 
 /// One thread's tables, for the windows it colours.
 struct ChunkTables {
   std::uint32_t* mask;                    // body_count words
+  std::uint32_t tag = kLastTag;           // the last window's tag
   ScratchVector<std::uint32_t>* levels;   // the overflow's level table, filled on first use
   std::vector<std::uint32_t> overflow;    // the overflow's levels, in input order
   std::vector<std::uint32_t> level_slot;  // its counting sort
@@ -39,15 +49,22 @@ struct ChunkTables {
   ColourSummary summary;
 };
 
-/// Colours of window [w0, w1) into label[w0, w1); returns the window's
-/// highest colour + 1 (0 for a window of overflow only).
-std::uint32_t colour_window(const ContactIndices& c, std::size_t w0, std::size_t w1, std::uint32_t* __restrict mask,
-                            std::uint8_t* __restrict label, std::size_t& conflicts) {
+/// Every movable body's word free, every immovable body's tagged so.
+template <class T>
+void fill_tags(const InverseMasses<T>& inv_mass, std::size_t bodies, std::uint32_t* mask) {
+  for (std::size_t i = 0; i < bodies; ++i) mask[i] = (inv_mass.immovable(i) ? kImmovableTag : kFreeTag) << kTagShift;
+}
+
+/// Colours of window [w0, w1), whose tag is `tag`, into label[w0, w1);
+/// returns the window's highest colour + 1 (0 for a window of overflow only).
+std::uint32_t colour_window(const ContactIndices& c, std::size_t w0, std::size_t w1, std::uint32_t tag,
+                            std::uint32_t* __restrict mask, std::uint8_t* __restrict label, std::size_t& conflicts) {
   const BodyIndex* __restrict a = c.a;
   const BodyIndex* __restrict b = c.b;
   const std::size_t ahead = w1 > kPrefetchDistance ? w1 - kPrefetchDistance : 0;
   std::uint32_t used_colours = 0;
   std::size_t met = 0;
+  const std::uint32_t tagged = tag << kTagShift;
   for (std::size_t k = w0; k < w1; ++k) {
     if (k < ahead) {
       __builtin_prefetch(mask + a[k + kPrefetchDistance], 1, 3);
@@ -57,8 +74,8 @@ std::uint32_t colour_window(const ContactIndices& c, std::size_t w0, std::size_t
     const BodyIndex j = b[k];
     const std::uint32_t mi = mask[i];
     const std::uint32_t mj = mask[j];
-    const std::uint32_t held_i = movable(mi) ? mi : 0;
-    const std::uint32_t held_j = movable(mj) ? mj : 0;
+    const std::uint32_t held_i = (mi >> kTagShift) == tag ? mi & kColourBits : 0;
+    const std::uint32_t held_j = (mj >> kTagShift) == tag ? mj & kColourBits : 0;
     met += static_cast<std::size_t>(held_i != 0) + static_cast<std::size_t>(held_j != 0);
     const std::uint32_t free = ~(held_i | held_j) & kColourBits;
     const std::uint32_t colour = free != 0 ? static_cast<std::uint32_t>(std::countr_zero(free)) : kColours;
@@ -67,8 +84,8 @@ std::uint32_t colour_window(const ContactIndices& c, std::size_t w0, std::size_t
     used_colours |= bit;
     // Branches, not selects: a select would store the ground's word back
     // and chain every ground contact through it.
-    if (movable(mi)) mask[i] = mi | bit;
-    if (movable(mj)) mask[j] = mj | bit;
+    if (movable(mi)) mask[i] = tagged | held_i | bit;
+    if (movable(mj)) mask[j] = tagged | held_j | bit;
   }
   conflicts += met;
   return static_cast<std::uint32_t>(std::bit_width(used_colours));
@@ -116,15 +133,22 @@ void schedule_overflow(const ContactIndices& c, std::uint32_t* order, std::size_
 /// Window w: colours, the colour sort into order[w0, w1), the overflow's
 /// levels, and the table words cleared. False when an index of the window
 /// is bad (nothing was read through it).
-bool schedule_window(const ContactIndices& c, std::size_t w, ColourScratch& s, ChunkTables& t, std::uint32_t* order) {
+template <class T>
+bool schedule_window(const ContactIndices& c, const InverseMasses<T>& inv_mass, std::size_t w, ColourScratch& s,
+                     ChunkTables& t, std::uint32_t* order) {
   const std::size_t w0 = w * kWindow;
   const std::size_t w1 = std::min(c.count, w0 + kWindow);
   if (!indices_below(c.a + w0, c.b + w0, w1 - w0, index_bound(c.body_count)) &&
       first_bad_contact(c.a, c.b, w0, w1, c.body_count) != w1) {
     return false;
   }
+  if (t.tag == kLastTag) {
+    fill_tags(inv_mass, c.body_count, t.mask);
+    t.tag = 0;
+  }
+  ++t.tag;
   std::uint8_t* label = s.label.data();
-  const std::uint32_t colours = colour_window(c, w0, w1, t.mask, label, t.summary.conflicts);
+  const std::uint32_t colours = colour_window(c, w0, w1, t.tag, t.mask, label, t.summary.conflicts);
   t.summary.colours = std::max(t.summary.colours, colours);
 
   // The colour sort: colours 0 .. kColours - 1, then the overflow block.
@@ -146,10 +170,6 @@ bool schedule_window(const ContactIndices& c, std::size_t w, ColourScratch& s, C
   if (overflow != 0) {
     t.summary.overflow += overflow;
     schedule_overflow(c, order, w1 - overflow, w1, t.mask, t, batches);
-  }
-  for (std::size_t k = w0; k < w1; ++k) {
-    if (movable(t.mask[c.a[k]])) t.mask[c.a[k]] = 0;
-    if (movable(t.mask[c.b[k]])) t.mask[c.b[k]] = 0;
   }
   return true;
 }
@@ -176,12 +196,11 @@ ColourSummary colour_contacts(const ContactIndices& contacts, const InverseMasse
   for_each_chunk(windows, chunks, [&](std::size_t ch, std::size_t first, std::size_t last) {
     ScratchVector<std::uint32_t>& mask = scratch.masks[ch];
     mask.resize(contacts.body_count);
-    for (std::size_t i = 0; i < contacts.body_count; ++i) mask[i] = inv_mass.immovable(i) ? kImmovableBit : 0;
-    ChunkTables& t = tables[ch];
+    ChunkTables& t = tables[ch];  // tag kLastTag: the first window fills the table
     t.mask = mask.data();
     t.levels = &scratch.levels[ch];
     for (std::size_t w = first; w < last && w < first_failed.load(std::memory_order_relaxed); ++w) {
-      if (!schedule_window(contacts, w, scratch, t, order)) {
+      if (!schedule_window(contacts, inv_mass, w, scratch, t, order)) {
         std::size_t seen = first_failed.load(std::memory_order_relaxed);
         while (w < seen && !first_failed.compare_exchange_weak(seen, w, std::memory_order_relaxed)) {
         }

@@ -21,11 +21,12 @@
 //   nothing copied; and the windows are coloured independently, in parallel,
 //   with the same colours for any thread count.
 // * The colouring reads two words of a per-thread body table per contact:
-//   31 colour bits, and bit 31 set for an immovable body. Like the level
-//   pass, it is bound by those random reads on scattered scenes and
-//   prefetches the words kPrefetchDistance contacts ahead; after a window,
-//   the words it touched are cleared by a second walk of its contacts, in
-//   cache.
+//   24 colour bits and a tag that says which window they belong to (so no
+//   pass clears them between windows), or that the body is immovable. Like
+//   the level pass, it is bound by those random reads on scattered scenes
+//   and prefetches the words kPrefetchDistance contacts ahead. 24 colours,
+//   as Box2D's graph has: a pile needs 6, a debris scene's window rarely
+//   more than a dozen.
 // * Every index is screened (contact_indices.hpp) before the window's
 //   colouring reads a table word through it; a window that fails records
 //   itself, and the first bad contact of the first failing window is named,
@@ -37,6 +38,7 @@
 #include <vector>
 
 #include "batch_sort.hpp"
+#include "collide/schedule.hpp"
 #include "schedule_input.hpp"
 #include "scratch_vector.hpp"
 
@@ -44,7 +46,8 @@ namespace collide::detail {
 
 /// Colours a window may use; a contact that finds none of them free goes to
 /// the window's overflow.
-inline constexpr std::uint32_t kColours = 31;
+inline constexpr std::uint32_t kColours = 24;
+static_assert(kColours == Schedule::kMaxColours);
 
 /// What the colour pass keeps between builds.
 struct ColourScratch {

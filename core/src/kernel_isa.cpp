@@ -99,18 +99,28 @@ COLLIDE_LANE_INLINE void write_bodies(const View& view, const BodyLanes<M, V>& a
   velocity_fields<M>(view, a, b, f);
 }
 
-/// The streaming-pairs layout: contact l of the group joins bodies
-/// first + 2l and first + 2l + 1, so both sides come from 2W consecutive
-/// bodies (two vector loads and a deinterleave per field, instead of 2W
-/// scalar loads). This is how a caller lays out independent pairs, and how
-/// the pairs scene is built; any other layout takes the general gather.
+/// How the bodies of a group lie in the SoA arrays, which decides how they
+/// are read and written:
+/// * paired: contact l joins bodies first + 2l and first + 2l + 1, so both
+///   sides come from 2W consecutive bodies (two vector loads and a
+///   deinterleave per field, instead of 2W scalar loads). This is how a
+///   caller lays out independent pairs, how the pairs scene is built, and
+///   one colour of a chain or of a pile's x contacts in the colour order;
+/// * runs: the a bodies are W consecutive bodies, and so are the b bodies
+///   (one vector load per side and field): a pile's y and z contacts, one
+///   colour of them after another, in the colour order;
+/// * gathered: anything else, W scalar loads per side and field.
+enum class BodyStreams { gathered, paired, runs };
+
 template <std::size_t W>
-COLLIDE_LANE_INLINE bool is_paired_layout(const BodyIndex* ia, const BodyIndex* ib) {
+COLLIDE_LANE_INLINE BodyStreams body_streams(const BodyIndex* ia, const BodyIndex* ib) {
   bool paired = true;
+  bool runs = true;
   for (std::size_t l = 0; l < W; ++l) {
     paired &= (ia[l] == ia[0] + 2 * l) & (ib[l] == ia[l] + 1);
+    runs &= (ia[l] == ia[0] + l) & (ib[l] == ib[0] + l);
   }
-  return paired;
+  return paired ? BodyStreams::paired : runs ? BodyStreams::runs : BodyStreams::gathered;
 }
 
 /// True for the SoA views (BodyView, SphereView, ParticleView: one array per
@@ -151,22 +161,28 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
     ib[l] = contacts.b[k];
     assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
   }
-  // Only the SIMD path looks for the paired layout; the scalar path (W = 1)
-  // would gain nothing. The arithmetic is the same either way.
-  // The packed layout has no such shortcut (its records are already
-  // contiguous per body).
-  bool paired = false;
-  if constexpr (kSoaLayout<View>) paired = W > 1 && is_paired_layout<W>(ia, ib);
+  // Only the SIMD path looks for streams; the scalar path (W = 1) would gain
+  // nothing. The arithmetic is the same either way. The packed layout has
+  // no such shortcut (its records are already contiguous per body).
+  BodyStreams streams = BodyStreams::gathered;
+  if constexpr (kSoaLayout<View>) {
+    if constexpr (W > 1) streams = body_streams<W>(ia, ib);
+  }
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
   if constexpr (kSoaLayout<View>) {
-    if (paired) {
+    if (streams == BodyStreams::paired) {
       read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
         load_deinterleaved(field + ia[0], la, lb);
       });
+    } else if (streams == BodyStreams::runs) {
+      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        la = load<V>(field + ia[0]);
+        lb = load<V>(field + ib[0]);
+      });
     }
   }
-  if (!paired) gather_bodies<M, V, T>(bodies, ia, ib, a, b);
+  if (streams == BodyStreams::gathered) gather_bodies<M, V, T>(bodies, ia, ib, a, b);
 
   ContactLanes<V> c;
   if constexpr (kRotates<M>) {
@@ -184,10 +200,19 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
   const auto movable_b = b.inv_mass != V(0);
   bool written = false;
   if constexpr (kSoaLayout<View>) {
-    if (paired && stdx::all_of(movable_a && movable_b)) {
-      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-        store_interleaved(la, lb, field + ia[0]);
-      });
+    // Whole vectors only when every body is movable: a's and b's bodies are
+    // then all distinct, and no immovable one is written.
+    if (streams != BodyStreams::gathered && stdx::all_of(movable_a && movable_b)) {
+      if (streams == BodyStreams::paired) {
+        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+          store_interleaved(la, lb, field + ia[0]);
+        });
+      } else {
+        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+          store(la, field + ia[0]);
+          store(lb, field + ib[0]);
+        });
+      }
       written = true;
     }
   }

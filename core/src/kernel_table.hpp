@@ -28,7 +28,6 @@
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
 #include "collide/packed.hpp"
-#include "collide/solve.hpp"
 
 namespace collide::detail {
 

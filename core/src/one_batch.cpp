@@ -72,11 +72,15 @@ bool one_batch(const ContactIndices& contacts, const InverseMasses<T>& inv_mass,
   const std::size_t n = contacts.count;
   if (n == 0) return false;
   const std::size_t chunks = std::min(chunk_count(n, workers), kMaxClaimChunks);
-  // A first look, on the calling thread, before the body table is touched.
-  const std::size_t probe = std::min(n, kRepeatProbe);
-  if (!indices_below(contacts.a, contacts.b, probe, index_bound(contacts.body_count)) ||
-      movable_body_repeats(contacts.a, contacts.b, probe, inv_mass.data, inv_mass.stride, probe_set)) {
-    return false;
+  // A first look, on the calling thread, before the body table is touched
+  // on every thread; a scene of one chunk goes straight to its one claim
+  // pass, which stops at the first repeat as the look would.
+  if (chunks > 1) {
+    const std::size_t probe = std::min(n, kRepeatProbe);
+    if (!indices_below(contacts.a, contacts.b, probe, index_bound(contacts.body_count)) ||
+        movable_body_repeats(contacts.a, contacts.b, probe, inv_mass.data, inv_mass.stride, probe_set)) {
+      return false;
+    }
   }
   const std::size_t bodies = contacts.body_count;
   for_each_chunk(bodies, chunk_count(bodies, workers), [&](std::size_t, std::size_t begin, std::size_t end) {

@@ -56,10 +56,15 @@ template IsaPick pick_isa<double>(const SolverOptions&, IsaChoice, const KernelT
 std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b) {
   std::size_t n = 0;
   const std::uint32_t* order = schedule.order();
+  // A colour of a window holds every few contacts of a stretch of the input:
+  // not consecutive, but in a pile or a chain in a broadphase's order their
+  // bodies follow one another (the kernel then loads them as vectors,
+  // kernel_isa.cpp), so the colour order samples those batches too.
+  const bool sample_gathered = schedule.ordering() == Order::colour;
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
     const std::size_t begin = schedule.batch_begin(k);
     const std::size_t size = schedule.batch_begin(k + 1) - begin;
-    if (!schedule.batch_is_contiguous(k)) {
+    if (!schedule.batch_is_contiguous(k) && !(sample_gathered && size >= 1024)) {
       n += size;
       continue;
     }

@@ -108,8 +108,12 @@ TEST(Check, ImpactsAndRecord) {
                                              "layout",
                                              "accuracy",
                                              "lanes",
+                                             "order",
+                                             "passes",
                                              "batches",
                                              "largest_batch",
+                                             "colours",
+                                             "overflow_contacts",
                                              "schedule_seconds",
                                              "isa_calibration_seconds"};
   EXPECT_EQ(keys, expected);

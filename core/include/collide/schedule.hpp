@@ -98,7 +98,7 @@ class Schedule {
   /// Contacts per window of the colour order.
   static constexpr std::size_t kColourWindow = std::size_t{1} << 16;
   /// Colours a window of the colour order may use before its overflow.
-  static constexpr std::uint32_t kMaxColours = 31;
+  static constexpr std::uint32_t kMaxColours = 24;
 
   /// An empty schedule that build() fills in `order`.
   explicit Schedule(Order order = Order::input);

@@ -33,13 +33,14 @@ double median(std::vector<double> values) {
 }
 
 template <class T>
-ReferenceResult reference_of(const Scene<T>& sample) {
+ReferenceResult reference_of(const Scene<T>& sample, const std::uint32_t* order) {
   Scene<L> s = convert_scene<L>(sample);
   ReferenceResult r;
   r.before = momentum_totals<L>(std::as_const(s.bodies).view());
   r.impulses.resize(s.contacts.size());
   r.diagnostics.resize(s.contacts.size());
-  reference_solve<L>(s.bodies.view(), s.contacts.view(), r.impulses.view(), r.diagnostics.data());
+  reference_solve<L>(s.bodies.view(), s.contacts.view(), r.impulses.view(), r.diagnostics.data(),
+                     SolveSequence{order, 1});
   r.after = momentum_totals<L>(std::as_const(s.bodies).view());
   return r;
 }
@@ -80,8 +81,8 @@ void fill_error(ReportRow& row, const ImpulseView<const T>& j, const BodyView<co
   row.energy_drift = drift.energy;
 }
 
-template ReferenceResult reference_of<float>(const Scene<float>&);
-template ReferenceResult reference_of<double>(const Scene<double>&);
+template ReferenceResult reference_of<float>(const Scene<float>&, const std::uint32_t*);
+template ReferenceResult reference_of<double>(const Scene<double>&, const std::uint32_t*);
 template void fill_error<float>(ReportRow&, const ImpulseView<const float>&, const BodyView<const float>&,
                                 const ReferenceResult&, double);
 template void fill_error<double>(ReportRow&, const ImpulseView<const double>&, const BodyView<const double>&,

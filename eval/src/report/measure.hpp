@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -27,9 +28,10 @@ struct ReferenceResult {
   std::vector<ReferenceContact<long double>> diagnostics;
   MomentumTotals before, after;  ///< collide/eval/conservation.hpp
 };
-/// Solves convert_scene<long double>(sample) with reference_solve<long double>.
+/// Solves convert_scene<long double>(sample) with reference_solve<long double>,
+/// in input order or in `order` (a solve's Schedule::order()).
 template <class T>
-ReferenceResult reference_of(const Scene<T>& sample);
+ReferenceResult reference_of(const Scene<T>& sample, const std::uint32_t* order = nullptr);
 
 /// Fills the error columns of `row` from a variant's impulses and final
 /// bodies on the sample, in units of eps (the row's precision).

@@ -42,8 +42,12 @@ struct ReportRow {
   /// the scalar path, the references, the textbook loop and Bullet.
   std::string isa = "sse2";
   std::string layout = "soa";  ///< body layout the kernel ran on ("soa" or "packed"; SolveStats::layout)
-  int runs = 0;                ///< timed runs; the speed is their median
-  double seconds = 0;          ///< median time of one solve
+  /// The solve order (collide/schedule.hpp): "input", or "colour" for the
+  /// pile's rows in the colour order, whose error is against the reference
+  /// replaying that order.
+  std::string order = "input";
+  int runs = 0;        ///< timed runs; the speed is their median
+  double seconds = 0;  ///< median time of one solve
   double collisions_per_second = 0;
   double bytes_per_collision = 0;     ///< traffic.hpp, in the row's precision
   double bandwidth_fraction = 0;      ///< collisions/s x bytes / triad bandwidth (same thread count)

@@ -106,8 +106,8 @@ std::string format_report_json(const Report& report) {
          ", \"simd\": " + (r.simd ? "true" : "false") + ", \"friction\": " + (r.friction ? "true" : "false") +
          ", \"threads\": " + std::to_string(r.threads) + ", \"n\": " + std::to_string(r.n) +
          ", \"lanes\": " + std::to_string(r.lanes) + ", \"isa\": " + json_string(r.isa) +
-         ", \"layout\": " + json_string(r.layout) + ", \"runs\": " + std::to_string(r.runs) +
-         ", \"seconds\": " + json_number(r.seconds) +
+         ", \"layout\": " + json_string(r.layout) + ", \"order\": " + json_string(r.order) +
+         ", \"runs\": " + std::to_string(r.runs) + ", \"seconds\": " + json_number(r.seconds) +
          ", \"collisions_per_second\": " + json_number(r.collisions_per_second) +
          ", \"bytes_per_collision\": " + json_number(r.bytes_per_collision) +
          ", \"bandwidth_fraction\": " + json_number(r.bandwidth_fraction) +

@@ -215,19 +215,23 @@ class Runner {
     const std::size_t kernel = std::size_t{2} /*precisions*/ * 3 /*models*/ * kernel_variants().size();
     const std::size_t slow = 2 /*reference ld, double*/ + 2 /*textbook float, double*/;
     std::size_t rows = std::size_t{3} /*scenes*/ * 2 /*friction*/ * (kernel + slow);
+    rows += std::size_t{2} /*friction*/ * 2 /*precisions*/ * 3 /*models*/ *
+            config_.threads.size();  // the pile's colour order
     if (!bullet_version().empty()) ++rows;
     return rows;
   }
 
-  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy) {
-    auto& slot = solvers_[{
-        (path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) + (accuracy == Accuracy::accurate ? 16 : 0), threads}];
+  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy, Order order = Order::input) {
+    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) +
+                               (accuracy == Accuracy::accurate ? 16 : 0) + (order == Order::colour ? 32 : 0),
+                           threads}];
     if (!slot) {
       SolverOptions options;
       options.path = path;
       options.threads = threads;
       options.isa = isa;
       options.accuracy = accuracy;
+      options.order = order;
       slot = std::make_unique<Solver>(options);
     }
     return *slot;
@@ -316,6 +320,13 @@ class Runner {
     Schedule schedule, sample_schedule;
     schedule.build(scene.contacts.view(), scene.bodies.view());
     sample_schedule.build(sample.contacts.view(), sample.bodies.view());
+    // The pile also in the colour order collide chooses (collide/schedule.hpp).
+    const bool colour_rows = kind == SceneKind::pile;
+    Schedule colour_schedule(Order::colour), colour_sample_schedule(Order::colour);
+    if (colour_rows) {
+      colour_schedule.build(scene.contacts.view(), scene.bodies.view());
+      colour_sample_schedule.build(sample.contacts.view(), sample.bodies.view());
+    }
     ImpulseBuffer<T> impulses(scene.contacts.size());
     SavedVelocities<T> saved;
     const double eps = std::numeric_limits<T>::epsilon();
@@ -373,6 +384,44 @@ class Runner {
           add(std::move(row));
         }
       }
+      if (colour_rows)
+        colour_order_rows(kind, friction, model, scene, sample, saved, colour_schedule, colour_sample_schedule,
+                          impulses);
+    }
+  }
+
+  /// The SIMD path in the colour order at every thread count, its error
+  /// against the reference replaying that order on the sample.
+  template <class T>
+  void colour_order_rows(SceneKind kind, bool friction, Model model, Scene<T>& scene, const Scene<T>& sample,
+                         SavedVelocities<T>& saved, const Schedule& schedule, const Schedule& sample_schedule,
+                         ImpulseBuffer<T>& impulses) {
+    const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
+    progress_->show(what + ": long double reference of the " + to_string(model) + " sample in the colour order");
+    const ReferenceResult reference = reference_of(sample, sample_schedule.order());
+    for (const int threads : config_.threads) {
+      const Solver& s = solver(Path::simd, threads, default_isa(), Accuracy::fast, Order::colour);
+      ReportRow row = new_row(kind, "simd", model, precision_name<T>(), friction, threads, scene.contacts.size(),
+                              sample.contacts.size());
+      row.simd = true;
+      row.order = "colour";
+      row.note = "colour order";
+      const BodyView<T> bodies = scene.bodies.view();
+      const ContactView<T> contacts = scene.contacts.view();
+      SolveStats stats;
+      std::vector<double> seconds = time_runs(
+          config_.runs, [&] { saved.restore(bodies); },
+          [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
+      row.lanes = stats.lanes;
+      row.isa = to_string(stats.isa);
+      row.layout = to_string(stats.layout);
+      finish_speed(row, std::move(seconds), sizeof(T), model);
+      BodyBuffer<T> after = sample.bodies;
+      ImpulseBuffer<T> j(sample.contacts.size());
+      s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
+      fill_error<T>(row, std::as_const(j).view(), std::as_const(after).view(), reference,
+                    std::numeric_limits<T>::epsilon());
+      add(std::move(row));
     }
   }
   double triad_bw(int threads) const {
