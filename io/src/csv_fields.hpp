@@ -5,10 +5,14 @@
 // Design notes
 // ------------
 // * Numbers are read with std::from_chars (correctly rounded, locale-free,
-//   accepts inf, infinity and nan case-insensitively). A leading '+' is
-//   allowed. A value out of the range of T is an error if it overflows and
-//   rounds to a subnormal or zero if it underflows (strtof/strtod
-//   semantics).
+//   accepts inf, infinity and nan case-insensitively) as doubles, whatever
+//   the precision: the scene's value is the double nearest the text, and a
+//   float reader stores the float nearest that double (scene_value,
+//   collide/io/scene_values.hpp), as every other route does. A leading '+'
+//   is allowed. Text beyond the range of double is an error; text that
+//   underflows rounds to a subnormal or zero (strtod semantics). A double
+//   with no value in T (scene_value_fits) is refused with the reason every
+//   route gives for it.
 // * Two readers of a field, as the row readers have two paths
 //   (csv_read.cpp): fast_numbers for plain numbers, inlined into the row
 //   loop, and parse_value / parse_body_id, which trim, take a '+' and form
@@ -25,6 +29,7 @@
 #include <system_error>
 
 #include "collide/io/scene_io.hpp"
+#include "collide/io/scene_values.hpp"
 
 namespace collide::detail {
 
@@ -69,8 +74,9 @@ class FieldCursor {
   bool done_ = false;
 };
 
-/// Parses a real: the reader's own, text-level checks (the field is a
-/// number, and within the range of T), else false with the reason. The
+/// Parses a real: the double nearest the text, stored in T as scene_value
+/// gives it. The reader's own checks (the field is a number within the
+/// range of double, whose value fits T), else false with the reason. The
 /// value rules are rules.hpp's. For float and double.
 template <class T>
 bool parse_value(std::string_view field, T& value, std::string& reason);
@@ -83,12 +89,15 @@ bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id
 
 /// Reads N plain comma-separated numbers filling the whole of [p, e): no
 /// blanks, no '+', nothing out of range. False on anything else, which the
-/// careful path then parses or rejects with a message.
+/// careful path then parses or rejects with a message. Each number as
+/// parse_value stores it: the double, then scene_value.
 template <std::size_t N, class T>
 bool fast_numbers(const char* p, const char* e, T* out) {
   for (std::size_t k = 0; k < N; ++k) {
-    const auto [ptr, ec] = std::from_chars(p, e, out[k]);
-    if (ec != std::errc()) return false;
+    double x;
+    const auto [ptr, ec] = std::from_chars(p, e, x);
+    if (ec != std::errc() || !scene_value_fits<T>(x)) return false;
+    out[k] = scene_value<T>(x);
     if (k + 1 < N) {
       if (ptr == e || *ptr != ',') return false;
       p = ptr + 1;
