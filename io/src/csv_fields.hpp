@@ -27,6 +27,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 
 #include "collide/io/scene_io.hpp"
 #include "collide/io/scene_values.hpp"
@@ -94,10 +95,17 @@ bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id
 template <std::size_t N, class T>
 bool fast_numbers(const char* p, const char* e, T* out) {
   for (std::size_t k = 0; k < N; ++k) {
-    double x;
-    const auto [ptr, ec] = std::from_chars(p, e, x);
-    if (ec != std::errc() || !scene_value_fits<T>(x)) return false;
-    out[k] = scene_value<T>(x);
+    std::from_chars_result r;
+    if constexpr (std::is_same_v<T, double>) {
+      r = std::from_chars(p, e, out[k]);  // its own scene value, parsed in place
+      if (r.ec != std::errc()) return false;
+    } else {
+      double x;
+      r = std::from_chars(p, e, x);
+      if (r.ec != std::errc() || !scene_value_fits<T>(x)) return false;
+      out[k] = scene_value<T>(x);
+    }
+    const char* const ptr = r.ptr;
     if (k + 1 < N) {
       if (ptr == e || *ptr != ',') return false;
       p = ptr + 1;
