@@ -21,6 +21,8 @@ import zipfile
 
 import numpy as np
 
+from .. import _collide
+
 _LOCAL_HEADER = struct.Struct("<4s5H3I2H")  # the ZIP local file header, 30 bytes
 
 
@@ -73,7 +75,8 @@ class MappedNpz:
         """Rows ``rows`` (a slice, or an array of row numbers) of the 1-D
         members ``names`` as a (len(names), k) array of ``dtype``: a view of
         the mapping when the rows are a range, the members lie one stride
-        apart and hold ``dtype``; otherwise a new array (a gather, converted)."""
+        apart and hold ``dtype``; otherwise a new array (a gather, converted:
+        float64 to float32 by the library's rounding of scene values)."""
         dtype = np.dtype(dtype)
         cols = [self.columns[k] for k in names]
         count = len(range(*rows.indices(len(cols[0])))) if isinstance(rows, slice) else len(rows)
@@ -90,7 +93,11 @@ class MappedNpz:
                                   strides=(stride, item))
         out = np.empty((len(names), count), dtype)
         for r, c in enumerate(cols):
-            if isinstance(rows, slice) or c.dtype != dtype:
+            if c.dtype == np.float64 and dtype == np.float32:
+                # Scene values rounded to float as the library's readers
+                # round them (docs/collision-law.md, "Scene values").
+                _collide.scene_values(np.require(c[rows], requirements=("C", "A")), out[r])
+            elif isinstance(rows, slice) or c.dtype != dtype:
                 out[r] = c[rows]
             else:
                 np.take(c, rows, out=out[r])
