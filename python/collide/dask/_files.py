@@ -85,9 +85,11 @@ class MappedNpz:
             offsets = [self._offsets[k] for k in names]
             stride = offsets[1] - offsets[0] if len(names) > 1 else 0
             item = dtype.itemsize
+            # A view only where the solver can use it: aligned (np.savez's
+            # members lie at any offset), the rows one stride apart.
             one_stride = all(c.dtype == dtype and c.shape == cols[0].shape for c in cols) and all(
                 b - a == stride for a, b in zip(offsets, offsets[1:])) and stride % item == 0 and (
-                    len(names) == 1 or stride >= len(cols[0]) * item)
+                    offsets[0] % item == 0) and (len(names) == 1 or stride >= len(cols[0]) * item)
             if one_stride and count:
                 return np.ndarray((len(names), count), dtype, buffer=self._map, offset=offsets[0] + first * item,
                                   strides=(stride, item))
