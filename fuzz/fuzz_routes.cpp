@@ -174,7 +174,8 @@ class MemoryFile {
 std::string bodies_npz(const Drawn& d) {
   std::vector<collide::NpzColumn> cols;
   for (std::size_t k = 0; k < 17; ++k) {
-    cols.push_back({collide::kBodyColumns[k], collide::NpyType::f8, d.body_columns[k].data(), d.body_columns[k].size()});
+    cols.push_back(
+        {collide::kBodyColumns[k], collide::NpyType::f8, d.body_columns[k].data(), d.body_columns[k].size()});
   }
   return collide::format_npz(cols);
 }
@@ -183,8 +184,8 @@ std::string contacts_npz(const Drawn& d) {
   std::vector<collide::NpzColumn> cols = {{"a", collide::NpyType::u4, d.a.data(), d.a.size()},
                                           {"b", collide::NpyType::u4, d.b.data(), d.b.size()}};
   for (std::size_t k = 0; k < 8; ++k) {
-    cols.push_back(
-        {collide::kContactColumns[k + 2], collide::NpyType::f8, d.contact_columns[k].data(), d.contact_columns[k].size()});
+    cols.push_back({collide::kContactColumns[k + 2], collide::NpyType::f8, d.contact_columns[k].data(),
+                    d.contact_columns[k].size()});
   }
   return collide::format_npz(cols);
 }
@@ -257,7 +258,8 @@ void run(const Drawn& d, const MemoryFile& bnpz, const MemoryFile& cnpz) {
   collide::BodyTable<T> narrowed;
   const std::optional<collide::RowDefect> defect = collide::narrow_bodies(wide, narrowed);
   const Verdict by_columns =
-      defect ? Verdict{false, defect->row, std::string(defect->defect.column), defect->defect.reason} : Verdict{true};
+      defect ? Verdict{false, defect->row, std::string(defect->defect.column), defect->defect.reason}
+             : Verdict{true, 0, {}, {}};
   for (const auto& [name, v] : {std::pair<const char*, const Verdict&>{"the careful path", by_careful},
                                 {"npz", by_npz},
                                 {"npz, rules by SolveBodies", by_solve_bodies},
