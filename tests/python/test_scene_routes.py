@@ -4,8 +4,8 @@ collide.load of CSV, of `collide convert`'s '<f8' and '<f4' files, of
 np.savez's files and of mixed pairs, collide.from_physical from float64
 arrays with Contacts cast by NumPy), in float32 and float64, fast and
 accurate, gives the same bytes of v, w and J; a value beyond float and a
-subnormal the rules refuse are refused by every route with one reason.
-collide.dask's workers are test_dask.py's."""
+subnormal the rules refuse are refused by every route with one reason,
+collide.dask's included (the bytes its workers give are test_dask.py's)."""
 
 import os
 import re
