@@ -427,8 +427,9 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
     const auto defect = contact_defect(record(bad), body_count);  // contact_ok's verdict, with its reason
     throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
   }
-  if (range)
+  if (range) {
     throw SceneError(archive.file_name(), 0, range->row, std::string(range->defect.column), range->defect.reason);
+  }
   // As ContactBuffer::view(): a scene without friction runs the frictionless
   // kernel.
   const bool friction = first_failing_row(n, [&](std::size_t i) { return v.mu[i] == T(0); }) < n;
