@@ -267,7 +267,9 @@ std::string_view bodies_header();
 std::string_view contacts_header();
 std::string_view impulses_header();
 
-/// Appends one number in shortest round-trip form ("inf" for infinity).
+/// Appends one number in shortest round-trip form ("inf" for infinity): the
+/// shortest text that the readers read back to the same T (one float needs
+/// a digit more than its shortest text, csv_fields.hpp).
 template <class T>
 void append_number(std::string& out, T value);
 /// Appends one bodies.csv row (newline included), values as given.
