@@ -57,7 +57,7 @@ ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE "package|objects"
 
 # --- 2. Fuzzing -------------------------------------------------------------
 stage "fuzzing, ${fuzz_seconds}s per target"
-targets=(scene_io kernel entry npz)
+targets=(scene_io kernel entry npz routes)
 pids=()
 for t in "${targets[@]}"; do
   work="$asan/fuzz-work/$t"

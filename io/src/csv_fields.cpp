@@ -11,7 +11,6 @@
 #include <limits>
 #include <string>
 #include <system_error>
-#include <type_traits>
 
 #include "collide/rules.hpp"
 
@@ -35,8 +34,8 @@ namespace {
 
 enum class NumberStatus { ok, empty, syntax, overflow };
 
-template <class T>
-NumberStatus parse_real(std::string_view field, T& value) {
+/// The double nearest the text of a field.
+NumberStatus parse_real(std::string_view field, double& value) {
   field = trim(field);
   if (field.empty()) return NumberStatus::empty;
   const char* first = field.data();
@@ -54,12 +53,7 @@ NumberStatus parse_real(std::string_view field, T& value) {
   // zero as strtod does (the rare path, so a copy is fine).
   const std::string copy(first, last);
   errno = 0;
-  T v;
-  if constexpr (std::is_same_v<T, float>) {
-    v = std::strtof(copy.c_str(), nullptr);
-  } else {
-    v = std::strtod(copy.c_str(), nullptr);
-  }
+  const double v = std::strtod(copy.c_str(), nullptr);
   if (std::isinf(v)) return NumberStatus::overflow;
   value = v;
   return NumberStatus::ok;
@@ -69,9 +63,10 @@ NumberStatus parse_real(std::string_view field, T& value) {
 
 template <class T>
 bool parse_value(std::string_view field, T& value, std::string& reason) {
-  switch (parse_real(field, value)) {
+  double x = 0;
+  switch (parse_real(field, x)) {
     case NumberStatus::ok:
-      return true;
+      break;
     case NumberStatus::empty:
       reason = "empty value";
       return false;
@@ -79,10 +74,16 @@ bool parse_value(std::string_view field, T& value, std::string& reason) {
       reason = "not a number: " + quoted(field);
       return false;
     case NumberStatus::overflow:
-      reason = quoted(field) + " is out of the range of " + precision_name<T>();
+      // The text has no double, so no scene value, in either precision.
+      reason = quoted(field) + " is out of the range of double";
       return false;
   }
-  return false;
+  if (!scene_value_fits<T>(x)) {
+    reason = out_of_range_reason<T>(x);
+    return false;
+  }
+  value = scene_value<T>(x);
+  return true;
 }
 
 bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id, std::string& reason) {

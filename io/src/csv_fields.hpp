@@ -5,26 +5,35 @@
 // Design notes
 // ------------
 // * Numbers are read with std::from_chars (correctly rounded, locale-free,
-//   accepts inf, infinity and nan case-insensitively). A leading '+' is
-//   allowed. A value out of the range of T is an error if it overflows and
-//   rounds to a subnormal or zero if it underflows (strtof/strtod
-//   semantics).
+//   accepts inf, infinity and nan case-insensitively) as doubles, whatever
+//   the precision: the scene's value is the double nearest the text, and a
+//   float reader stores the float nearest that double (scene_value,
+//   collide/io/scene_values.hpp), as every other route does. A leading '+'
+//   is allowed. Text beyond the range of double is an error; text that
+//   underflows rounds to a subnormal or zero (strtod semantics). A double
+//   with no value in T (scene_value_fits) is refused with the reason every
+//   route gives for it.
 // * Two readers of a field, as the row readers have two paths
 //   (csv_read.cpp): fast_numbers for plain numbers, inlined into the row
 //   loop, and parse_value / parse_body_id, which trim, take a '+' and form
 //   the reason of a refused field. Both accept exactly the same values.
 // * Numbers are written with std::to_chars: the shortest text that reads
-//   back to the same T ("inf" for infinity).
+//   back to the same T as the readers read it, the double nearest the text
+//   rounded to T ("inf" for infinity). That is the shortest round-trip
+//   text of T, but for one float (put_number).
 #pragma once
 
 #include <charconv>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 
 #include "collide/io/scene_io.hpp"
+#include "collide/io/scene_values.hpp"
 
 namespace collide::detail {
 
@@ -69,8 +78,9 @@ class FieldCursor {
   bool done_ = false;
 };
 
-/// Parses a real: the reader's own, text-level checks (the field is a
-/// number, and within the range of T), else false with the reason. The
+/// Parses a real: the double nearest the text, stored in T as scene_value
+/// gives it. The reader's own checks (the field is a number within the
+/// range of double, whose value fits T), else false with the reason. The
 /// value rules are rules.hpp's. For float and double.
 template <class T>
 bool parse_value(std::string_view field, T& value, std::string& reason);
@@ -83,12 +93,22 @@ bool parse_body_id(std::string_view field, std::size_t body_count, BodyIndex& id
 
 /// Reads N plain comma-separated numbers filling the whole of [p, e): no
 /// blanks, no '+', nothing out of range. False on anything else, which the
-/// careful path then parses or rejects with a message.
+/// careful path then parses or rejects with a message. Each number as
+/// parse_value stores it: the double, then scene_value.
 template <std::size_t N, class T>
 bool fast_numbers(const char* p, const char* e, T* out) {
   for (std::size_t k = 0; k < N; ++k) {
-    const auto [ptr, ec] = std::from_chars(p, e, out[k]);
-    if (ec != std::errc()) return false;
+    std::from_chars_result r;
+    if constexpr (std::is_same_v<T, double>) {
+      r = std::from_chars(p, e, out[k]);  // its own scene value, parsed in place
+      if (r.ec != std::errc()) return false;
+    } else {
+      double x;
+      r = std::from_chars(p, e, x);
+      if (r.ec != std::errc() || !scene_value_fits<T>(x)) return false;
+      out[k] = scene_value<T>(x);
+    }
+    const char* const ptr = r.ptr;
     if (k + 1 < N) {
       if (ptr == e || *ptr != ',') return false;
       p = ptr + 1;
@@ -108,9 +128,28 @@ inline constexpr std::size_t kMaxNumberChars = 26;
 /// Upper bound on the characters of one body id (2^32 - 1: 10).
 inline constexpr std::size_t kMaxIdChars = 12;
 
-/// Writes `value` at p (room for kMaxNumberChars) and returns the end.
+/// The bits of the one positive float whose shortest text does not read
+/// back to it as a scene value: the double nearest "7.038531e-26" is
+/// within half a double's spacing of the midpoint above the float, so it
+/// rounds to that midpoint and then, ties to even, to the float above.
+/// Every other finite float's shortest text does read back (all 2^31
+/// positive ones were tried: to_chars, then from_chars as a double, then
+/// static_cast<float>).
+inline constexpr std::uint32_t kFloatWhoseShortestTextMisreads = 0x15AE43FD;
+
+/// Writes `value` at p (room for kMaxNumberChars) and returns the end: the
+/// shortest text that reads back to the same T as a scene value (double,
+/// then T: scene_values.hpp), which is the shortest round-trip text of T
+/// for every value but 7.038531e-26 in float, written with one digit more.
 template <class T>
 inline char* put_number(char* p, T value) {
+  if constexpr (std::is_same_v<T, float>) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    if ((bits & 0x7FFFFFFFU) == kFloatWhoseShortestTextMisreads) {
+      return std::to_chars(p, p + kMaxNumberChars, value, std::chars_format::scientific, 7).ptr;  // 7.0385307e-26
+    }
+  }
   // Shortest round trip; to_chars writes inf as "inf" already.
   return std::to_chars(p, p + kMaxNumberChars, value).ptr;
 }

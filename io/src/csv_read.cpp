@@ -18,10 +18,12 @@
 //   careful one (split, trim, '+', messages) for everything else. Both accept
 //   exactly the same values; the careful one alone builds messages. The
 //   fields' text is csv_fields.hpp's.
-// * The reader checks the text (numbers, columns, the range of T); the value
-//   rules of the spec are rules.hpp's (body_ok / contact_ok on the fast path,
-//   body_defect / contact_defect for the message), on the values in T, the
-//   precision the kernel will see.
+// * The reader checks the text (numbers, columns, the range of double) and
+//   stores each number as every route stores a scene value: the double
+//   nearest the text, rounded to T (scene_value, refused when it does not
+//   fit T; csv_fields.hpp). The value rules of the spec are rules.hpp's
+//   (body_ok / contact_ok on the fast path, body_defect / contact_defect
+//   for the message), on the values in T, the precision the kernel will see.
 #include "collide/io/scene_io.hpp"
 
 #include <algorithm>

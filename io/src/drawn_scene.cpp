@@ -12,8 +12,8 @@
 // * Blocks of 8192 items: a few megabytes of text per block in flight (a
 //   pair is about 800 bytes of CSV), enough to keep the threads busy.
 // * npz: the columns are drawn in parallel into a BodyTable and contact
-//   columns (each value static_cast to T, as detail::narrow rounds the
-//   generated scenes), then written by write_body_table_npz and
+//   columns (each value rounded to T by scene_value, as detail::narrow
+//   rounds the generated scenes), then written by write_body_table_npz and
 //   write_contacts_npz. Held whole, as a column-by-column file needs them:
 //   about 340 bytes a pair in double.
 #include "collide/io/drawn_scene.hpp"
@@ -30,6 +30,7 @@
 #include <oneapi/tbb/parallel_for.h>
 
 #include "collide/io/scene_io.hpp"
+#include "collide/io/scene_values.hpp"
 #include "ordered_blocks.hpp"
 
 namespace collide {
@@ -81,14 +82,14 @@ class SceneColumns {
   void put_body(std::size_t i, const BodyRecord<double>& r) {
     const double v[17] = {r.m,    r.I[0], r.I[1], r.I[2], r.q[0], r.q[1], r.q[2], r.q[3], r.p[0],
                           r.p[1], r.p[2], r.v[0], r.v[1], r.v[2], r.w[0], r.w[1], r.w[2]};
-    for (std::size_t k = 0; k < 17; ++k) table_.column[k][i] = static_cast<T>(v[k]);
+    for (std::size_t k = 0; k < 17; ++k) table_.column[k][i] = scene_value<T>(v[k]);
   }
 
   void put_contact(std::size_t k, const ContactRecord<double>& c) {
     a_[k] = c.a;
     b_[k] = c.b;
     const double v[8] = {c.c[0], c.c[1], c.c[2], c.n[0], c.n[1], c.n[2], c.e, c.mu};
-    for (std::size_t j = 0; j < 8; ++j) real_[j][k] = static_cast<T>(v[j]);
+    for (std::size_t j = 0; j < 8; ++j) real_[j][k] = scene_value<T>(v[j]);
   }
 
   void write(OutputFile& bodies, OutputFile& contacts) const {

@@ -9,11 +9,13 @@
 //   with a defect is scanned again, row by row on one thread, for the first
 //   defect and its message, so the fast path forms no message and the
 //   message does not depend on threads.
-// * A real column in the other precision is rounded to T by static_cast
-//   (round to nearest), as the CSV reader rounds decimal text; a finite
-//   double that overflows float is refused ("out of the range of float"),
-//   as the CSV reader refuses such text, instead of turning a huge mass
-//   into an immovable body.
+// * A real column in the other precision is converted as every route
+//   converts a scene value (collide/io/scene_values.hpp): '<f4' widened
+//   exactly, '<f8' rounded to the nearest float (narrow_column), as the CSV
+//   reader stores the double nearest its text. A finite double that
+//   overflows float is refused ("value 1e+39 is out of the range of float"),
+//   as from CSV, instead of turning a huge mass into an immovable body; the
+//   row reported is the CSV reader's (first_body_defect_before).
 // * The writers list the columns and hand them to write_npz: a column that
 //   lies in a mapping goes from the page cache to the output without a copy
 //   of ours.
@@ -36,6 +38,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "collide/io/scene_values.hpp"
 #include "collide/rules.hpp"
 #include "collide/validate.hpp"
 #include "screen_chunks.hpp"
@@ -120,12 +123,6 @@ std::size_t first_failing_row(std::size_t n, const Ok& ok) {
   return i;
 }
 
-std::string shortest_text(double x) {
-  std::string s;
-  append_number(s, x);  // the writers' shortest round-trip text
-  return s;
-}
-
 template <class From, class T>
 void convert_into(const std::byte* data, std::size_t n, T* out) {
   oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, std::size_t{1} << 16),
@@ -140,10 +137,12 @@ void convert_into(const std::byte* data, std::size_t n, T* out) {
 
 /// Column `m` in precision T: the member's own bytes when it holds T and is
 /// aligned for T, else a converted copy in `owned`. Refuses a dtype that is
-/// not a real one, and a double that overflows float.
+/// not a real one. `out_of_range` receives the first row whose double does
+/// not fit T (narrow_column), or the count.
 template <class T>
 const T* real_column(const NpzArchive& archive, const NpzMember& m, NpyType precision, std::vector<T>& owned,
-                     bool& in_place) {
+                     bool& in_place, std::size_t& out_of_range) {
+  out_of_range = m.count;
   if (!is_real(m.type)) {
     member_error(archive, m.name,
                  "dtype " + std::string(npy_descr(m.type)) + ": real columns are '<f4' (float) or '<f8' (double)");
@@ -159,24 +158,29 @@ const T* real_column(const NpzArchive& archive, const NpzMember& m, NpyType prec
   }
   owned.resize(m.count);
   if (m.type == NpyType::f4) {
-    convert_into<float>(m.data, m.count, owned.data());
+    convert_into<float>(m.data, m.count, owned.data());  // exact: a float is its own scene value
   } else {
-    convert_into<double>(m.data, m.count, owned.data());
-    if constexpr (std::is_same_v<T, float>) {
-      const auto stored = [&](std::size_t i) {
-        double x;
-        std::memcpy(&x, m.data + i * sizeof(double), sizeof(double));
-        return x;
-      };
-      const std::size_t bad = first_failing_row(
-          m.count, [&](std::size_t i) { return !std::isfinite(stored(i)) || std::isfinite(owned[i]); });
-      if (bad < m.count) {
-        throw SceneError(archive.file_name(), 0, bad, m.name,
-                         "value " + shortest_text(stored(bad)) + " is out of the range of float");
-      }
-    }
+    out_of_range = narrow_column(m.data, m.count, owned.data());
   }
   return owned.data();
+}
+
+/// Element `row` of an '<f8' member.
+double stored_double(const NpzMember& m, std::size_t row) {
+  double x;
+  std::memcpy(&x, m.data + row * sizeof(double), sizeof(double));
+  return x;
+}
+
+/// Keeps in `range` the first value out of T's range over the columns
+/// visited in order (the least row, and in it the first column): `row` is
+/// real_column's for member `m`, the table's column `column`.
+template <class T>
+void keep_first_out_of_range(std::optional<RowDefect>& range, const NpzMember& m, std::string_view column,
+                             std::size_t row) {
+  if (row < m.count && (!range || row < range->row)) {
+    range = RowDefect{row, Defect{column, out_of_range_reason<T>(stored_double(m, row))}};
+  }
 }
 
 /// An id column as BodyIndex: in place for aligned '<u4', else converted,
@@ -278,10 +282,18 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRul
   const NpyType precision = npz_scene_precision(archive);
   const std::size_t n = members[0]->count;
   out.columns_.count = n;
+  std::optional<RowDefect> range;
   for (std::size_t k = 0; k < kBodyColumns.size(); ++k) {
     bool in_place = false;
-    out.columns_.column[k] = real_column<T>(archive, *members[k], precision, out.table_.column[k], in_place);
+    std::size_t out_of_range = n;
+    out.columns_.column[k] =
+        real_column<T>(archive, *members[k], precision, out.table_.column[k], in_place, out_of_range);
     out.mapped_ |= in_place;
+    keep_first_out_of_range<T>(range, *members[k], kBodyColumns[k], out_of_range);
+  }
+  if (range) {
+    const RowDefect bad = first_body_defect_before(out.columns_, std::move(*range));
+    throw SceneError(archive.file_name(), 0, bad.row, std::string(bad.defect.column), bad.defect.reason);
   }
   if (rules == BodyRules::checked) {
     out.check();
@@ -377,10 +389,13 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
   out.mapped_ |= in_place;
   out.owned_.resize(kContactColumns.size());
   const T* real[8];
+  std::optional<RowDefect> range;
   for (std::size_t k = 2; k < kContactColumns.size(); ++k) {
     in_place = false;
-    real[k - 2] = real_column<T>(archive, *members[k], precision, out.owned_[k], in_place);
+    std::size_t out_of_range = n;
+    real[k - 2] = real_column<T>(archive, *members[k], precision, out.owned_[k], in_place, out_of_range);
     out.mapped_ |= in_place;
+    keep_first_out_of_range<T>(range, *members[k], kContactColumns[k], out_of_range);
   }
   v.c = {real[0], real[1], real[2]};
   v.n = {real[3], real[4], real[5]};
@@ -401,13 +416,19 @@ LoadedContacts<T> load_contacts(const std::string& path, SceneFormat format, std
     return r;
   };
   // The lane layer's screen first (validate.hpp); only a scene it does not
-  // clear is judged row by row, exactly.
-  const std::size_t bad = contacts_pass_screen(v, body_count)
-                              ? n
-                              : first_failing_row(n, [&](std::size_t i) { return contact_ok(record(i), body_count); });
-  if (bad < n) {
+  // clear is judged row by row, exactly. With a value out of T's range, the
+  // rows before it are judged, as the CSV reader meets them first.
+  const std::size_t limit = range ? range->row : n;
+  const std::size_t bad =
+      !range && contacts_pass_screen(v, body_count)
+          ? n
+          : first_failing_row(limit, [&](std::size_t i) { return contact_ok(record(i), body_count); });
+  if (bad < limit) {
     const auto defect = contact_defect(record(bad), body_count);  // contact_ok's verdict, with its reason
     throw SceneError(archive.file_name(), 0, bad, std::string(defect->column), defect->reason);
+  }
+  if (range) {
+    throw SceneError(archive.file_name(), 0, range->row, std::string(range->defect.column), range->defect.reason);
   }
   // As ContactBuffer::view(): a scene without friction runs the frictionless
   // kernel.

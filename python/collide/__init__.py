@@ -236,20 +236,29 @@ def from_physical(m, inertia, q, p, v=None, w=None, *, dtype=_np.float64):
     """Bodies from physical units: mass m (N,) (inf = immovable), principal
     moments ``inertia`` (3, N) (inf = no rotation about that axis), any
     non-zero quaternion q (4, N) (stored as given; the law normalises it),
-    p, v, w (3, N); v and w default to zero. Array-likes are converted to
-    ``dtype``; the result owns new arrays.
+    p, v, w (3, N); v and w default to zero. Arrays of ``dtype`` are used as
+    they are; anything else is taken as float64 scene values, which a
+    float32 result holds as every scene file reader holds them: the float
+    nearest each double (docs/collision-law.md, "Scene values"). The result
+    owns new arrays.
 
     Every body must obey the input rules of the scene files, in ``dtype``
     (the library's collide/rules.hpp: no NaN, inf only in m and inertia,
-    m and the moments > 0 with a finite inverse, |q|^2 a normal number):
+    m and the moments > 0 with a finite inverse, |q|^2 a normal number),
+    and a float32 result every value within float's range:
     ValueError("from_physical: body 3, column 'm': mass must be > 0, got -1"),
     the reason :func:`read_scene` gives for the same value in a file."""
     dt = _np.dtype(dtype)
+    given = [x for x in (m, inertia, q, p, v, w) if x is not None]
+    if not all(isinstance(x, _np.ndarray) and x.dtype == dt for x in given):
+        dt_in = _np.dtype(_np.float64)  # scene values, rounded by the library
+    else:
+        dt_in = dt
 
     def arr(x, rows):
         if x is None:
-            return _np.zeros((rows, len(_np.asarray(m))), dtype=dt)
-        return _np.ascontiguousarray(x, dtype=dt)
+            return _np.zeros((rows, len(_np.asarray(m))), dtype=dt_in)
+        return _np.ascontiguousarray(x, dtype=dt_in)
 
     return _collide.from_physical(arr(m, 0), arr(inertia, 3), arr(q, 4), arr(p, 3), arr(v, 3), arr(w, 3), dt)
 

@@ -13,7 +13,13 @@
 //   seventeen columns of a bodies file, with no copy, so Python refuses
 //   what the file readers refuse, with their reason; the message names the
 //   body and the column, "from_physical: body 3, column 'm': mass must be
-//   > 0, got -1". The inverses are the readers' too (inverses_of).
+//   > 0, got -1". The inverses are the readers' too (inverses_of). float64
+//   arrays for a float32 result are scene values, rounded to float as the
+//   readers round them (narrow_bodies, collide/io/scene_values.hpp), and a
+//   value beyond float is refused with the readers' reason, not made inf.
+// * scene_values rounds a float64 array into a float32 one the same way, for
+//   collide.dask's workers, which read their rows of a binary file
+//   themselves.
 // * inverses gives those inverses alone, without the rules and without a
 //   copy of anything else: for a caller that holds columns a reader has
 //   already checked (collide.dask's workers, over their rows of a file the
@@ -33,6 +39,7 @@
 #include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/io/scene_io.hpp"
+#include "collide/io/scene_values.hpp"
 #include "scene.hpp"
 
 namespace collide::python {
@@ -137,35 +144,52 @@ py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed
 
 /// Bodies from physical units: mass (inf = immovable), principal moments
 /// (inf = no rotation about that axis), any non-zero quaternion (stored as
-/// given: the law normalises it).
+/// given: the law normalises it). The arrays hold `dtype`, or float64 scene
+/// values for a float32 result (rounded as the readers round them).
 py::object from_physical_py(const py::object& m_in, const py::object& inertia_in, const py::object& q_in,
                             const py::object& p_in, const py::object& v_in, const py::object& w_in,
                             const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
+  const bool wide = d == Dtype::f32 && py::isinstance<py::array>(m_in) &&
+                    py::reinterpret_borrow<py::array>(m_in).dtype().equal(py::dtype::of<double>());
+  const Dtype given = wide ? Dtype::f64 : d;
   const py::dtype dt = numpy_dtype(d);
-  const char* dn = dtype_name(d);
+  const py::dtype gdt = numpy_dtype(given);
+  const char* gdn = dtype_name(given);
   const std::string owner = "from_physical";
-  const py::array m = checked_array(owner, "m", m_in, dt, dn, 0, false);
-  const py::array I = checked_array(owner, "inertia", inertia_in, dt, dn, 3, false);
-  const py::array q = checked_array(owner, "q", q_in, dt, dn, 4, false);
-  const py::array p = checked_array(owner, "p", p_in, dt, dn, 3, false);
-  const py::array v = checked_array(owner, "v", v_in, dt, dn, 3, false);
-  const py::array w = checked_array(owner, "w", w_in, dt, dn, 3, false);
+  const py::array m = checked_array(owner, "m", m_in, gdt, gdn, 0, false);
+  const py::array I = checked_array(owner, "inertia", inertia_in, gdt, gdn, 3, false);
+  const py::array q = checked_array(owner, "q", q_in, gdt, gdn, 4, false);
+  const py::array p = checked_array(owner, "p", p_in, gdt, gdn, 3, false);
+  const py::array v = checked_array(owner, "v", v_in, gdt, gdn, 3, false);
+  const py::array w = checked_array(owner, "w", w_in, gdt, gdn, 3, false);
   const std::size_t n = length(m);
   for (const auto& [name, a] :
        {std::pair<const char*, const py::array*>{"inertia", &I}, {"q", &q}, {"p", &p}, {"v", &v}, {"w", &w}}) {
     require_length(owner, name, *a, n, "m");
   }
+  // The arrays are the columns of a bodies file (kBodyColumns order).
+  const auto columns_over = [&](auto tag) {
+    using U = decltype(tag);
+    BodyColumns<U> c;
+    c.count = n;
+    c.column = {data<U>(m),   row<U>(I, 0), row<U>(I, 1), row<U>(I, 2), row<U>(q, 0), row<U>(q, 1),
+                row<U>(q, 2), row<U>(q, 3), row<U>(p, 0), row<U>(p, 1), row<U>(p, 2), row<U>(v, 0),
+                row<U>(v, 1), row<U>(v, 2), row<U>(w, 0), row<U>(w, 1), row<U>(w, 2)};
+    return c;
+  };
   return with_dtype(d, [&](auto tag) {
     using T = decltype(tag);
-    // The arrays are the columns of a bodies file (kBodyColumns order).
+    BodyTable<T> rounded;  // the values in T of float64 arrays for a float32 result
     BodyColumns<T> columns;
-    columns.count = n;
-    columns.column = {data<T>(m),   row<T>(I, 0), row<T>(I, 1), row<T>(I, 2), row<T>(q, 0), row<T>(q, 1),
-                      row<T>(q, 2), row<T>(q, 3), row<T>(p, 0), row<T>(p, 1), row<T>(p, 2), row<T>(v, 0),
-                      row<T>(v, 1), row<T>(v, 2), row<T>(w, 0), row<T>(w, 1), row<T>(w, 2)};
     std::optional<RowDefect> defect;
-    {
+    if (wide) {
+      const BodyColumns<double> scene = columns_over(double{});
+      py::gil_scoped_release release;
+      defect = narrow_bodies(scene, rounded);
+      columns = columns_of(rounded);
+    } else {
+      columns = columns_over(T{});
       py::gil_scoped_release release;
       defect = first_body_defect(columns);
     }
@@ -189,6 +213,32 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
       return copy_rows<T>(dt, columns.column.data() + first, rows, n);
     };
     return py::cast(Bodies(inv_mass, inv_inertia, copy(4, 4), copy(8, 3), copy(11, 3), copy(14, 3)));
+  });
+}
+
+/// Scene values (a float64 array) rounded into `out` (a float32 array of the
+/// same shape, or float64: a copy) as the readers round them; ValueError
+/// naming the first element beyond float, with the readers' reason. For
+/// rows a caller reads itself from a file the readers have checked
+/// (collide.dask's workers).
+void scene_values_py(const py::object& values_in, const py::object& out_in) {
+  const std::string owner = "scene_values";
+  const py::array values = checked_array(owner, "values", values_in, py::dtype::of<double>(), "float64", 0, false);
+  const Dtype d = scene_dtype("scene_values.out", out_in);
+  const py::array out = checked_array(owner, "out", out_in, numpy_dtype(d), dtype_name(d), 0, true);
+  const std::size_t n = length(values);
+  require_length(owner, "out", out, n, "values");
+  with_dtype(d, [&](auto tag) {
+    using T = decltype(tag);
+    std::size_t bad = n;
+    {
+      py::gil_scoped_release release;
+      bad = narrow_column(values.data(), n, data<T>(out));
+    }
+    if (bad < n) {
+      throw py::value_error(owner + ": element " + std::to_string(bad) + ": " +
+                            out_of_range_reason<T>(data<double>(values)[bad]));
+    }
   });
 }
 
@@ -296,6 +346,7 @@ void register_scene(py::module_& m) {
   m.def("from_physical", &from_physical_py, py::arg("m"), py::arg("inertia"), py::arg("q"), py::arg("p"), py::arg("v"),
         py::arg("w"), py::arg("dtype"));
   m.def("inverses", &inverses_py, py::arg("m"), py::arg("inertia"));
+  m.def("scene_values", &scene_values_py, py::arg("values"), py::arg("out"));
   m.def("choose_model", &choose_model_py, py::arg("bodies"), py::arg("contacts"), py::arg("check") = true);
   m.def("model_misfit", &model_misfit_py, py::arg("bodies"), py::arg("contacts"), py::arg("model"));
 }

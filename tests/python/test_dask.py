@@ -11,6 +11,7 @@ fails, it does not skip.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -23,8 +24,11 @@ import distributed
 
 import collide
 import collide.dask as cd
+from conftest import run
+from scene_value_text import draw_scene, scene_files, write
 
 FIELDS = ("inv_mass", "inv_inertia", "q", "p", "v", "w")
+TWO_BODIES = os.path.join(os.path.dirname(__file__), "..", "..", "data", "scene-values", "two-bodies")
 
 
 @pytest.fixture(scope="module")
@@ -147,6 +151,33 @@ def test_scene_files_same_bytes_written_in_place(client, tmp_path, model, dtype,
         expected32 = reference_bytes(*collide.load(bp, cp, dtype=np.float32), accuracy=accuracy)
         same_bytes(cd.solve((bp, cp), client, out_dir=tmp_path / "out32", dtype=np.float32, accuracy=accuracy),
                    expected32)
+
+
+@pytest.mark.parametrize("scene", ["two-bodies", "drawn", "debris"])
+def test_scene_files_give_the_csv_readers_bytes(client, cli, tmp_path, scene):
+    # One scene, one answer (docs/collision-law.md, "Scene values"): the
+    # workers round the rows of a '<f8' file to float32 as the readers round
+    # the scene's CSV text, halfway cases, subnormals and floats' largest
+    # included; in float64 the values are the file's.
+    d = str(tmp_path)
+    if scene == "two-bodies":
+        for name in ("bodies.csv", "contacts.csv"):
+            shutil.copy(os.path.join(TWO_BODIES, name), d)
+    elif scene == "drawn":
+        bodies_text, contacts_text, parted = draw_scene(3)
+        assert parted > 1000
+        write(os.path.join(d, "bodies.csv"), bodies_text)
+        write(os.path.join(d, "contacts.csv"), contacts_text)
+    else:
+        run([cli, "gen", "--debris", "20000", "--out", d, "--seed", "2", "--friction"])
+    files = scene_files(cli, d, run)
+    for dtype in (np.float32, np.float64):
+        for accuracy in ("fast", "accurate"):
+            expected = reference_bytes(*collide.read_scene(*files["csv"], dtype=dtype), accuracy=accuracy)
+            for tag in ("f8", "np"):
+                out = tmp_path / f"out-{tag}-{np.dtype(dtype).name}-{accuracy}"
+                same_bytes(cd.solve(files[tag], client, out_dir=out, dtype=dtype, accuracy=accuracy, partitions=2),
+                           expected)
 
 
 def chained_scenes(*parts):

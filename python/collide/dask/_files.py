@@ -21,6 +21,8 @@ import zipfile
 
 import numpy as np
 
+from .. import _collide
+
 _LOCAL_HEADER = struct.Struct("<4s5H3I2H")  # the ZIP local file header, 30 bytes
 
 
@@ -73,7 +75,8 @@ class MappedNpz:
         """Rows ``rows`` (a slice, or an array of row numbers) of the 1-D
         members ``names`` as a (len(names), k) array of ``dtype``: a view of
         the mapping when the rows are a range, the members lie one stride
-        apart and hold ``dtype``; otherwise a new array (a gather, converted)."""
+        apart and hold ``dtype``; otherwise a new array (a gather, converted:
+        float64 to float32 by the library's rounding of scene values)."""
         dtype = np.dtype(dtype)
         cols = [self.columns[k] for k in names]
         count = len(range(*rows.indices(len(cols[0])))) if isinstance(rows, slice) else len(rows)
@@ -82,15 +85,21 @@ class MappedNpz:
             offsets = [self._offsets[k] for k in names]
             stride = offsets[1] - offsets[0] if len(names) > 1 else 0
             item = dtype.itemsize
+            # A view only where the solver can use it: aligned (np.savez's
+            # members lie at any offset), the rows one stride apart.
             one_stride = all(c.dtype == dtype and c.shape == cols[0].shape for c in cols) and all(
                 b - a == stride for a, b in zip(offsets, offsets[1:])) and stride % item == 0 and (
-                    len(names) == 1 or stride >= len(cols[0]) * item)
+                    offsets[0] % item == 0) and (len(names) == 1 or stride >= len(cols[0]) * item)
             if one_stride and count:
                 return np.ndarray((len(names), count), dtype, buffer=self._map, offset=offsets[0] + first * item,
                                   strides=(stride, item))
         out = np.empty((len(names), count), dtype)
         for r, c in enumerate(cols):
-            if isinstance(rows, slice) or c.dtype != dtype:
+            if c.dtype == np.float64 and dtype == np.float32:
+                # Scene values rounded to float as the library's readers
+                # round them (docs/collision-law.md, "Scene values").
+                _collide.scene_values(np.require(c[rows], requirements=("C", "A")), out[r])
+            elif isinstance(rows, slice) or c.dtype != dtype:
                 out[r] = c[rows]
             else:
                 np.take(c, rows, out=out[r])

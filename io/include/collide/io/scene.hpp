@@ -3,9 +3,11 @@
 #pragma once
 
 #include <cstddef>
+#include <type_traits>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/io/scene_values.hpp"
 
 namespace collide {
 
@@ -65,38 +67,41 @@ Scene<S> convert_scene(const Scene<U>& src) {
 }  // namespace collide
 
 // A scene record drawn in double, stored in the scene's precision: each value
-// rounded once by static_cast, nothing renormalised, so the stored values are
-// exactly what the kernel and the reference then read. The generators
-// (io/generate.hpp) and the hard scenes (eval/hard_scenes.hpp) draw in double.
-// The same cast takes a record of any precision U to T: narrow<double> of a
-// float record widens it, exactly.
+// rounded once, as every route stores a scene value (scene_value,
+// collide/io/scene_values.hpp), nothing renormalised, so the stored values
+// are exactly what the kernel and the reference then read, and what the
+// scene's files give. The generators (io/generate.hpp) and the hard scenes
+// (eval/hard_scenes.hpp) draw in double. A float record (U = float) is
+// widened exactly first: narrow<double> of a float record widens it.
 namespace collide::detail {
 
 template <class T, class U = double>
 BodyRecord<T> narrow(const BodyRecord<U>& r) {
+  static_assert(std::is_same_v<U, double> || std::is_same_v<U, float>, "records of scene values: double or float");
   BodyRecord<T> o;
-  o.m = static_cast<T>(r.m);
+  o.m = scene_value<T>(r.m);
   for (int k = 0; k < 3; ++k) {
-    o.I[k] = static_cast<T>(r.I[k]);
-    o.p[k] = static_cast<T>(r.p[k]);
-    o.v[k] = static_cast<T>(r.v[k]);
-    o.w[k] = static_cast<T>(r.w[k]);
+    o.I[k] = scene_value<T>(r.I[k]);
+    o.p[k] = scene_value<T>(r.p[k]);
+    o.v[k] = scene_value<T>(r.v[k]);
+    o.w[k] = scene_value<T>(r.w[k]);
   }
-  for (int k = 0; k < 4; ++k) o.q[k] = static_cast<T>(r.q[k]);
+  for (int k = 0; k < 4; ++k) o.q[k] = scene_value<T>(r.q[k]);
   return o;
 }
 
 template <class T, class U = double>
 ContactRecord<T> narrow(const ContactRecord<U>& r) {
+  static_assert(std::is_same_v<U, double> || std::is_same_v<U, float>, "records of scene values: double or float");
   ContactRecord<T> o;
   o.a = r.a;
   o.b = r.b;
   for (int k = 0; k < 3; ++k) {
-    o.c[k] = static_cast<T>(r.c[k]);
-    o.n[k] = static_cast<T>(r.n[k]);
+    o.c[k] = scene_value<T>(r.c[k]);
+    o.n[k] = scene_value<T>(r.n[k]);
   }
-  o.e = static_cast<T>(r.e);
-  o.mu = static_cast<T>(r.mu);
+  o.e = scene_value<T>(r.e);
+  o.mu = scene_value<T>(r.mu);
   return o;
 }
 

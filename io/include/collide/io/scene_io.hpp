@@ -12,13 +12,16 @@
 //   the 1-based line, the 0-based data row (the body or contact id) and the
 //   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got -1".
 //   What the text itself gets wrong (not a number, an empty field, a missing
-//   or extra column, a value out of the range of T) is the reader's to say;
-//   a row whose every field parses is then checked with the rules of
-//   collide/rules.hpp, on the parsed T values, and the reason is theirs, the
-//   same text the buffers and the Python constructors give for the same
-//   value. So a value that is fine in double but unusable in float (1e39, a
-//   mass of 1e-45, a quaternion too small to normalise) is rejected with the
-//   precision named. A row with both kinds of defect reports the text one.
+//   or extra column, a number beyond the range of double) is the reader's to
+//   say; each number is the double nearest its text, stored in T as every
+//   route stores a scene value (collide/io/scene_values.hpp: a double with
+//   no value in T is refused with the reason every route gives). A row whose
+//   every field parses is then checked with the rules of collide/rules.hpp,
+//   on the T values, and the reason is theirs, the same text the buffers and
+//   the Python constructors give for the same value. So a value that is fine
+//   in double but unusable in float (1e39, a mass of 1e-45, a quaternion too
+//   small to normalise) is rejected with the precision named. A row with
+//   both kinds of defect reports the text one.
 // * The parse-from-memory entry points (`parse_bodies`, `parse_contacts`)
 //   take the text and a file name for the messages, so fuzzers and tests can
 //   drive the parser without files.
@@ -273,7 +276,9 @@ std::string_view bodies_header();
 std::string_view contacts_header();
 std::string_view impulses_header();
 
-/// Appends one number in shortest round-trip form ("inf" for infinity).
+/// Appends one number in shortest round-trip form ("inf" for infinity): the
+/// shortest text that the readers read back to the same T (one float needs
+/// a digit more than its shortest text, csv_fields.hpp).
 template <class T>
 void append_number(std::string& out, T value);
 /// Appends one bodies.csv row (newline included), values as given.
