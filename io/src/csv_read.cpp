@@ -1,4 +1,4 @@
-// csv_read.cpp - reading the scene CSV files of the spec: bodies.csv into a
+// csv_read.cpp - reading the scene CSV files of docs/collision-law.md: bodies.csv into a
 // BodyTable, contacts.csv into a ContactBuffer (collide/io/scene_io.hpp).
 //
 // Design notes
@@ -19,7 +19,7 @@
 //   exactly the same values; the careful one alone builds messages. The
 //   fields' text is csv_fields.hpp's.
 // * The reader checks the text (numbers, columns, the range of T); the value
-//   rules of the spec are rules.hpp's (body_ok / contact_ok on the fast path,
+//   rules of docs/collision-law.md are rules.hpp's (body_ok / contact_ok on the fast path,
 //   body_defect / contact_defect for the message), on the values in T, the
 //   precision the kernel will see.
 #include "collide/io/scene_io.hpp"
