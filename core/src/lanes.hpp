@@ -219,6 +219,7 @@ COLLIDE_LANE_INLINE V lane_min(const V& a, const V& b) {
 template <class V>
 COLLIDE_LANE_INLINE V canonical_nan(const V& x) {
   using T = typename V::value_type;
+  // NOLINTNEXTLINE(misc-redundant-expression): x == x is false exactly in a NaN lane
   return select(x == x, x, V(std::numeric_limits<T>::quiet_NaN()));
 }
 
