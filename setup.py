@@ -41,7 +41,7 @@ class CMakeBuild(build_ext):
             "-DCMAKE_BUILD_TYPE=Release",
             "-DCOLLIDE_BUILD_TESTS=OFF", "-DCOLLIDE_BUILD_BENCH=OFF", "-DCOLLIDE_BUILD_CLI=OFF",
             "-DCOLLIDE_BUILD_EXAMPLES=OFF", "-DCOLLIDE_INSTALL=OFF", "-DCOLLIDE_BUILD_PYTHON=ON",
-            "-DPYTHON_EXECUTABLE=" + sys.executable, "-DPython_EXECUTABLE=" + sys.executable,
+            "-DPython3_EXECUTABLE=" + sys.executable,
         ]
         env = dict(os.environ)
         if shutil.which("ccache"):

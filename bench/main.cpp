@@ -6,7 +6,7 @@
 // What runs and in which order is registration.cpp's, how a row is timed
 // rows.cpp's, the summary summary.cpp's. Flags of our own, removed before
 // Google Benchmark sees argv:
-//   --quick          float only, N in {64Ki, 4Mi}: the rows the targets need
+//   --quick          float only, N in {64Ki, 4Mi}: the rows the summary reads
 //   --sizes=a,b,...  the N to run (default 1e4, 64Ki, 256Ki, 1Mi, 4Mi, 16Mi)
 //   --scene=B,C      also the rows of one group on the scene in the files B
 //                    (bodies) and C (contacts), CSV or binary (.npz) by name,

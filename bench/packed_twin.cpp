@@ -29,7 +29,9 @@ template <>
 struct RowOf<double> {
   typedef double type __attribute__((vector_size(16)));  // NOLINT(modernize-use-using): attribute on a typedef
 };
-constexpr std::size_t kAhead = 32;  // contacts; as the kernel (COLLIDE_PREFETCH_AHEAD)
+// Contacts ahead whose records are requested: the kernel's kPrefetchAhead,
+// set by the build (COLLIDE_PREFETCH_AHEAD, cmake/options.cmake).
+constexpr std::size_t kAhead = COLLIDE_PREFETCH_AHEAD;
 constexpr std::size_t kBlock = 1024;
 constexpr std::size_t kGroup = 16;  // contacts whose loads precede their stores: the kernel's float lanes on AVX-512
 }  // namespace

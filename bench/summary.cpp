@@ -7,7 +7,9 @@
 //   rows the reporter kept; a row that did not run (filtered out, --quick, an
 //   ISA the CPU lacks) leaves its figure "n/a" or its table line out.
 // * With --benchmark_repetitions the summary uses the medians.
-// * A target is MET or MISSED against the goal the README states.
+// * The summary states figures of this run and their ratios, the ones
+//   docs/performance.md and the README's table report; it judges none of
+//   them (what a figure should be is for the reader's machine and purpose).
 #include "summary.hpp"
 
 #include <algorithm>
@@ -107,29 +109,28 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     print("WARNING: the start-up check failed (see above); the numbers below time a wrong result\n");
   }
 
-  print("\nTargets                                                                measured   target\n");
-  auto target = [&](const char* what, double value, double goal, const char* unit) {
+  print("\nRatios of this run                                                     measured\n");
+  auto figure = [&](const char* what, double value, const char* unit) {
     if (!(value > 0)) {
-      print("  %-68s %9s  >= %4.2f%s  (rows not run)\n", what, "n/a", goal, unit);
+      print("  %-68s %9s  (rows not run)\n", what, "n/a");
       return;
     }
-    print("  %-68s %8.2f%s  >= %4.2f%s  %s\n", what, value, unit, goal, unit, value >= goal ? "MET" : "MISSED");
+    print("  %-68s %8.2f%s\n", what, value, unit);
   };
   {
     const Result r = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, kStreamN));
-    target("pairs f32 simd t:2 n:4Mi, fraction of bandwidth bound", r.bw_frac, 0.60, "");
+    figure("pairs f32 simd t:2 n:4Mi, fraction of bandwidth bound", r.bw_frac, "");
   }
   {
     const Result simd = rep.get(solve_name(Kind::pairs, f32, Path::simd, 1, kCacheN));
     const Result scalar = rep.get(solve_name(Kind::pairs, f32, Path::scalar, 1, kCacheN));
-    target("pairs f32 t:1 n:64Ki, simd / scalar", simd.valid && scalar.valid ? simd.coll_per_s / scalar.coll_per_s : 0,
-           5.0, "x");
+    figure("pairs f32 t:1 n:64Ki, simd / scalar", simd.valid && scalar.valid ? simd.coll_per_s / scalar.coll_per_s : 0, "x");
   }
   {
     const Result t2 = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, kCacheN));
     const Result t1 = rep.get(solve_name(Kind::pairs, f32, Path::simd, 1, kCacheN));
-    target("pairs f32 simd n:64Ki (in LLC), 2 threads / 1 thread",
-           t1.valid && t2.valid ? t2.coll_per_s / t1.coll_per_s : 0, 1.8, "x");
+    figure("pairs f32 simd n:64Ki (in LLC), 2 threads / 1 thread",
+           t1.valid && t2.valid ? t2.coll_per_s / t1.coll_per_s : 0, "x");
   }
   {
     // The widest ISA against AVX2, in cache and streaming.
@@ -140,16 +141,16 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
       return ra.valid && rb.valid ? ra.coll_per_s / rb.coll_per_s : 0.0;
     };
     if (collide::isa_supported(Isa::avx512)) {
-      target("pairs f32 t:1 n:64Ki, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 1, kCacheN), 1.5, "x");
+      figure("pairs f32 t:1 n:64Ki, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 1, kCacheN), "x");
       const Result wide = rep.get(isa_name(Kind::pairs, f32, Isa::avx512, 1, kCacheN));
       const Result scalar = rep.get(solve_name(Kind::pairs, f32, Path::scalar, 1, kCacheN));
-      target("pairs f32 t:1 n:64Ki, avx512 / scalar",
-             wide.valid && scalar.valid ? wide.coll_per_s / scalar.coll_per_s : 0, 7.0, "x");
-      target("pairs f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 2, kStreamN), 1.0, "x");
-      target("debris f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::debris, Isa::avx512, Isa::avx2, 2, kStreamN), 1.0, "x");
+      figure("pairs f32 t:1 n:64Ki, avx512 / scalar",
+             wide.valid && scalar.valid ? wide.coll_per_s / scalar.coll_per_s : 0, "x");
+      figure("pairs f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::pairs, Isa::avx512, Isa::avx2, 2, kStreamN), "x");
+      figure("debris f32 t:2 n:4Mi, avx512 / avx2", ratio(Kind::debris, Isa::avx512, Isa::avx2, 2, kStreamN), "x");
     }
     if (collide::isa_supported(Isa::avx2)) {
-      target("pairs f32 t:1 n:64Ki, avx2 / sse2", ratio(Kind::pairs, Isa::avx2, Isa::sse2, 1, kCacheN), 1.0, "x");
+      figure("pairs f32 t:1 n:64Ki, avx2 / sse2", ratio(Kind::pairs, Isa::avx2, Isa::sse2, 1, kCacheN), "x");
     }
   }
   {
@@ -165,52 +166,50 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
       const double records = per_s(layout_name(Kind::debris, model, false, f32, LayoutRow::records, 2, kStreamN));
       const double pairs = per_s(model_name(Kind::pairs, model, false, f32, 2, kStreamN));
       const double twin = per_s(packed_twin_name(Kind::debris, model, f32, 2, kStreamN));
-      target(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), 0.5, "");
+      figure(("debris " + m + " f32 t:2 n:4Mi, packed records / pairs").c_str(), ratio(records, pairs), "");
       const std::string vs_twin = "debris " + m + " f32 t:2 n:4Mi, packed records / its memory-only twin";
       if (records > 0 && twin > 0 && records > twin) {
-        // A twin slower than the kernel bounds nothing: no verdict.
-        print("  %-68s %8.2f   NOT JUDGED: the twin runs below the kernel, so it is no ceiling\n", vs_twin.c_str(),
+        // A twin slower than the kernel bounds nothing.
+        print("  %-68s %8.2f   (the twin runs below the kernel, so it is no ceiling)\n", vs_twin.c_str(),
               ratio(records, twin));
       } else {
-        target(vs_twin.c_str(), ratio(records, twin), 0.7, "");
+        figure(vs_twin.c_str(), ratio(records, twin), "");
       }
-      // Not a target: the twin's own rate against pairs (a ceiling for the
-      // line above only where the twin runs faster than the kernel).
+      // The twin's own rate against pairs (a ceiling for the line above only
+      // where the twin runs faster than the kernel).
       const double twin_vs_pairs = ratio(twin, pairs);
       if (twin_vs_pairs > 0) {
-        print("  %-68s %8.2f   (not a target)\n", ("  its twin / " + m + " pairs").c_str(), twin_vs_pairs);
+        print("  %-68s %8.2f\n", ("  its twin / " + m + " pairs").c_str(), twin_vs_pairs);
       }
     }
     const double simd = per_s(solve_name(Kind::debris, f32, Path::simd, 2, kStreamN));
     const double scalar = per_s(solve_name(Kind::debris, f32, Path::scalar, 2, kStreamN));
-    target("debris f32 t:2 n:4Mi (SoA input, automatic layout), simd / scalar", ratio(simd, scalar), 3.0, "x");
+    figure("debris f32 t:2 n:4Mi (SoA input, automatic layout), simd / scalar", ratio(simd, scalar), "x");
   }
   {
     const Result d = rep.get(solve_name(Kind::debris, f32, Path::simd, 2, kStreamN));
     const Result p = rep.get(solve_name(Kind::pairs, f32, Path::simd, 2, kStreamN));
-    target("f32 simd t:2 n:4Mi, debris / pairs throughput", d.valid && p.valid ? d.coll_per_s / p.coll_per_s : 0, 0.50,
-           "");
+    figure("f32 simd t:2 n:4Mi, debris / pairs throughput", d.valid && p.valid ? d.coll_per_s / p.coll_per_s : 0, "");
     // Piles: every body in about six contacts, so its record can come from
-    // cache from one level to the next; a pile should run near pairs speed.
+    // cache from one level to the next.
     const std::size_t pile_n = pile_size(kStreamN);
     for (const Kind kind : {Kind::pile, Kind::pile_shuffled}) {
       const Result q = rep.get(solve_name(kind, f32, Path::simd, 2, pile_n));
       const std::string what = std::string("f32 simd t:2 n:4Mi, ") + kind_name(kind) + " / pairs throughput";
-      target(what.c_str(), q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, 0.70, "");
+      figure(what.c_str(), q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, "");
     }
     // The chain: one batch per contact, every contact waiting for the one
-    // before, so no lanes or threads across contacts; a quarter of pairs speed.
+    // before, so no lanes or threads across contacts.
     {
       const Result q = rep.get(solve_name(Kind::chain, f32, Path::simd, 2, kStreamN));
-      target("f32 simd t:2 n:4Mi, chain / pairs throughput", q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, 0.25,
-             "");
+      figure("f32 simd t:2 n:4Mi, chain / pairs throughput", q.valid && p.valid ? q.coll_per_s / p.coll_per_s : 0, "");
     }
     // The schedule, which a debris system rebuilds every frame.
     for (const Kind kind : {Kind::pairs, Kind::debris, Kind::pile, Kind::chain}) {
       const std::size_t n = is_pile(kind) ? pile_n : kStreamN;
       const Result s = rep.get(schedule_name(kind, f32, n));
       const std::string what = std::string("schedule ") + kind_name(kind) + " f32 n:4Mi, M contacts/s";
-      target(what.c_str(), s.valid ? s.coll_per_s / 1e6 : 0, 200.0, "");
+      figure(what.c_str(), s.valid ? s.coll_per_s / 1e6 : 0, "");
     }
   }
 
@@ -218,8 +217,8 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
     using collide::Model;
     const Result particle = rep.get(model_name(Kind::pairs, Model::particle, false, f32, 2, kStreamN));
     const Result rigid = rep.get(model_name(Kind::pairs, Model::rigid, false, f32, 2, kStreamN));
-    target("pairs f32 t:2 n:4Mi, particle / rigid throughput (no friction)",
-           particle.valid && rigid.valid ? particle.coll_per_s / rigid.coll_per_s : 0, 2.0, "x");
+    figure("pairs f32 t:2 n:4Mi, particle / rigid throughput (no friction)",
+           particle.valid && rigid.valid ? particle.coll_per_s / rigid.coll_per_s : 0, "x");
     // The lowest and highest of a figure over the models, with their names.
     struct Range {
       double low = 0, high = 0;
@@ -251,12 +250,12 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
         }
       }
     }
-    target(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + bound_frac.low_name + ")").c_str(),
-           bound_frac.low, 0.60, "");
-    // Not a target: what the data layout allows (memory_twin.hpp).
+    figure(("pairs f32 t:2 n:4Mi, lowest model fraction of its bound (" + bound_frac.low_name + ")").c_str(),
+           bound_frac.low, "");
+    // What the data layout allows (memory_twin.hpp).
     if (of_twin.any) {
       print(
-          "  (not a target: the models' memory-only twins reach %.2f to %.2f of the bound, and the models\n"
+          "  (the models' memory-only twins reach %.2f to %.2f of the bound, and the models\n"
           "   reach %.2f (%s) to %.2f (%s) of their twin's throughput)\n",
           twin_frac.low, twin_frac.high, of_twin.low, of_twin.low_name.c_str(), of_twin.high,
           of_twin.high_name.c_str());
@@ -283,16 +282,15 @@ void print_summary(const CollectingReporter& rep, const Options& options, bool c
           }
           if (!automatic.valid || !best_row.valid) continue;
           if (!header) {
-            print("\nisa auto against the best fixed ISA (isa/ rows; target: auto >= 0.97 x best on every row)\n");
+            print("\nisa auto against the best fixed ISA (isa/ rows; every ISA gives the same bits)\n");
             print("  %-7s %-4s %3s %9s  %-7s %9s  %-9s %9s  %6s\n", "scene", "prec", "t", "N", "best", "Mcoll/s",
                   "auto ran", "Mcoll/s", "ratio");
             header = true;
           }
           const std::string ran = automatic.label.substr(0, automatic.label.find(','));
           const double r = automatic.coll_per_s / best_row.coll_per_s;
-          print("  %-7s %-4s %3d %9zu  %-7s %9.1f  %-9s %9.1f  %6.3f  %s\n", kind_name(kind), precision.tag, threads, n,
-                collide::to_string(best), best_row.coll_per_s / 1e6, ran.c_str(), automatic.coll_per_s / 1e6, r,
-                r >= 0.97 ? "MET" : "MISSED");
+          print("  %-7s %-4s %3d %9zu  %-7s %9.1f  %-9s %9.1f  %6.3f\n", kind_name(kind), precision.tag, threads, n,
+                collide::to_string(best), best_row.coll_per_s / 1e6, ran.c_str(), automatic.coll_per_s / 1e6, r);
         }
       }
     }

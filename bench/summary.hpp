@@ -1,5 +1,5 @@
 // bench/summary.hpp - the summary collide_bench prints after its run: the
-// README's targets and ratios, the body-model and throughput tables and the
+// run's ratios, the body-model and throughput tables and the
 // memory of every scene, all from the rows of the same run (summary.cpp).
 #pragma once
 

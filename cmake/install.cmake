@@ -28,11 +28,9 @@
 #   `cmake --install build --prefix anywhere` gives a working file without
 #   reconfiguring.
 # * Install rules are generated when collide is the top-level project, or when
-#   an embedding project asks for them (COLLIDE_INSTALL=ON).
+#   an embedding project asks for them (COLLIDE_INSTALL=ON, cmake/options.cmake).
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
-
-option(COLLIDE_INSTALL "Generate the install rules for collide" ${PROJECT_IS_TOP_LEVEL})
 
 get_target_property(COLLIDE_LIBRARY_TYPE collide TYPE)
 
@@ -109,6 +107,13 @@ endif()
 set(COLLIDE_NEEDS_DEFLATE OFF)
 if(COLLIDE_NEEDS_TBB AND TARGET collide_io)
   set(COLLIDE_NEEDS_DEFLATE ON)
+endif()
+# collide_SIMD of the config file: the SIMD kernels the library holds, among
+# which it chooses at run time (COLLIDE_KERNEL_ISAS; "native" where the target
+# has one kernel for its own lanes).
+set(COLLIDE_SIMD "${COLLIDE_KERNEL_ISAS}")
+if(NOT COLLIDE_SIMD)
+  set(COLLIDE_SIMD native)
 endif()
 set(COLLIDE_COMPONENTS "")
 if(TARGET collide_io)

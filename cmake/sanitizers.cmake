@@ -6,13 +6,14 @@
 #   COLLIDE_SANITIZE      comma- or semicolon-separated -fsanitize= list, e.g.
 #                         "address,undefined" or "thread"; empty = no sanitizer.
 #   COLLIDE_SANITIZE_OPT  optimisation level of a sanitizer build (default -O1).
+# (Both are declared and checked with the other options, cmake/options.cmake.)
 #
 # Why these flags:
 #   * -fno-sanitize-recover=all: UBSan otherwise prints a report and carries
 #     on, and the test passes; with it the first UB aborts the process, so a
 #     ctest run or a fuzzer fails on it.
 #   * -fno-omit-frame-pointer -g: readable stacks in the reports.
-#   * -O1: solve.cpp instantiates the kernel for 3 models x 2 paths x 2
+#   * -O1: kernel_isa.cpp instantiates the kernel for 3 models x 2 paths x 2
 #     precisions x friction; at -O0 with instrumentation the tests run many
 #     times slower and at -O2/-O3 the build takes longer, for no extra
 #     findings. The level is applied after the build type's flags, so it wins.
@@ -27,42 +28,22 @@
 # library, not only in the fuzz drivers; the drivers link -fsanitize=fuzzer
 # (fuzz/CMakeLists.txt). The same build directory then runs the ASan+UBSan
 # test suite and the fuzzers (see scripts/ci-sanitizers.sh).
-set(COLLIDE_SANITIZE "" CACHE STRING "Sanitizers for every target: address,undefined or thread (empty: none)")
-set(COLLIDE_SANITIZE_OPT "-O1" CACHE STRING "Optimisation level of sanitizer builds")
-
-# A fuzzing build without an explicit choice fuzzes under ASan and UBSan.
-if(COLLIDE_BUILD_FUZZ AND NOT COLLIDE_SANITIZE)
-  set(COLLIDE_SANITIZE "address,undefined")
-endif()
-
 if(COLLIDE_SANITIZE)
   string(REPLACE ";" "," _collide_sanitize "${COLLIDE_SANITIZE}")
-  if(_collide_sanitize MATCHES "thread" AND _collide_sanitize MATCHES "address")
-    message(FATAL_ERROR "COLLIDE_SANITIZE: thread and address sanitizers cannot be combined")
-  endif()
   message(STATUS "collide: sanitizers ${_collide_sanitize} (${COLLIDE_SANITIZE_OPT})")
   add_compile_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all -fno-omit-frame-pointer -g
                       ${COLLIDE_SANITIZE_OPT})
   add_link_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all)
   if(_collide_sanitize MATCHES "thread")
-    # TBB's hand-overs become visible to TSan through the ITT bridge (see
-    # tests/tsan/itt_tsan_bridge.cpp): the TBB headers notify spawn, join and
+    # TBB's hand-overs become visible to TSan through the ITT bridge (tests/tsan/,
+    # built there with the race canary): the TBB headers notify spawn, join and
     # wait only when compiled with TBB_USE_PROFILING_TOOLS=2, and libtbb loads
     # the bridge named by INTEL_LIBITTNOTIFY64.
     add_compile_definitions(TBB_USE_PROFILING_TOOLS=2)
-    add_library(collide_itt_tsan MODULE ${PROJECT_SOURCE_DIR}/tests/tsan/itt_tsan_bridge.cpp)
-    set_target_properties(collide_itt_tsan PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR})
-    # The negative control: a deliberate race TSan must report (not a ctest test).
-    add_executable(collide_race_canary ${PROJECT_SOURCE_DIR}/tests/tsan/race_canary.cpp)
-    target_link_libraries(collide_race_canary PRIVATE collide collide_io TBB::tbb)
-    set_target_properties(collide_race_canary PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR})
   endif()
   unset(_collide_sanitize)
 endif()
 
 if(COLLIDE_BUILD_FUZZ)
-  if(NOT CMAKE_CXX_COMPILER_ID MATCHES "Clang")
-    message(FATAL_ERROR "COLLIDE_BUILD_FUZZ needs Clang (libFuzzer); configure with -DCMAKE_CXX_COMPILER=clang++")
-  endif()
   add_compile_options(-fsanitize=fuzzer-no-link)
 endif()

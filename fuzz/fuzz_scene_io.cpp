@@ -6,11 +6,12 @@
 //   (ASan, UBSan and libFuzzer's -timeout / -rss_limit_mb catch the rest);
 //   a SceneError always names the file it was given;
 // * what they accept is usable: to_body_buffer() converts it, every contact
-//   index is < the body count and a != b, and every value the spec restricts
+//   index is < the body count and a != b, and every value docs/collision-law.md restricts
 //   is in range (m, I > 0; |n| = 1 after normalisation; e in [0, 1]; mu >= 0;
 //   no NaN);
 // * writing accepted bodies back (format_bodies) and reading the text again
-//   gives the same numbers, bit for bit: the spec's round-trip promise.
+//   gives the same numbers, bit for bit: the round trip docs/collision-law.md
+//   promises.
 //
 // Input layout: the bytes up to the first NUL are bodies.csv, the rest (or
 // the same bytes, when there is no NUL) contacts.csv. The corpus seeds in

@@ -15,9 +15,9 @@ set -euo pipefail
 # ccache: scripts/build.sh and setup.py compile through it when present, so the
 # pip install test reuses the normal build's objects (python/CMakeLists.txt).
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
-# scripts/ci-sanitizers.sh.
+# scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh.
 packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev libdeflate-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev clang-tidy-14
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip
   python3-dask python3-distributed python3-pandas)
 

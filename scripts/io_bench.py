@@ -1,4 +1,5 @@
-"""Figures of the scene files (docs/decisions/0002, docs/cli.md): what reading
+"""Figures of the scene files (docs/decisions/0002-binary-scene-files.md,
+docs/cli.md): what reading
 and writing a scene costs in the binary format, against CSV, against `cat`
 of the same bytes, and collide.load from Python.
 
@@ -13,7 +14,7 @@ converted to CSV (`collide convert`). Then, --runs times, alternated:
   * `cat` of the binary run's four files (inputs and outputs) to /dev/null,
     page cache warm, and of its two inputs alone; and `cat` of its two
     outputs into a new file: what writing those bytes into new page-cache
-    pages costs on this machine, whoever writes them. collide's read and
+    pages costs on the machine that runs it, whoever writes them. collide's read and
     write are compared with both: cat of all four files to /dev/null, and
     cat moving the same bytes the way the solve does (the inputs read, the
     outputs written into new files);
@@ -21,12 +22,13 @@ and then --loads calls of `collide.load` of the binary scene in a row in this
 process, checking that the arrays it returns are views of the files'
 mappings, not copies.
 
-Prints the best and median of each, the ratios the scene-file targets name
-(binary I/O against CSV I/O and against cat, io_fraction, collide.load),
-and checks that binary -> CSV -> binary gives the same bytes. Exit 1 if the
-round trip or the views check fails. The machine varies: this VM hands
-memory back to its host, and a run that writes into new pages costs two to
-five times a quiet one; compare the best runs (docs/decisions/0019).
+Prints the best and median of each, the ratios of
+docs/decisions/0027-writing-the-binary-scene-files.md (binary I/O against
+CSV I/O and against cat, io_fraction, collide.load), and checks that
+binary -> CSV -> binary gives the same bytes. Exit 1 if the round trip or
+the views check fails. Runs vary: a virtual machine that hands memory back
+to its host makes a run that writes into new pages cost two to five times a
+quiet one; compare the best runs.
 
     PYTHONPATH=build/python /usr/bin/python3 scripts/io_bench.py [--collide build/collide]
     PYTHONPATH=build/python /usr/bin/python3 scripts/io_bench.py --n 100000 --runs 2   # a smoke run
@@ -153,7 +155,8 @@ def main():
         row("cat of the two outputs into a new file", cat_write)
         row("collide.load (Python, views of the mapping)", load, unit="ms", scale=1000)
         best_npz = min(io(s) for s in npz)
-        print("\nratios of the best runs (targets in brackets):")
+        # In brackets: the values decisions 0024 and 0027 measure against.
+        print("\nratios of the best runs (in brackets: the values of docs/decisions/0024 and 0027):")
         print(f"  CSV I/O / binary I/O      {min(io(s) for s in csv) / best_npz:6.1f}x   [>= 30x]")
         print(f"  binary I/O / cat          {best_npz / min(cat):6.2f}x   [<= 3x]  (writing the outputs' bytes into a new "
               f"file alone, by cat: {min(cat_write) / min(cat):.2f}x)")

@@ -9,7 +9,7 @@
 // Solver is built (kernel_table(Isa)). The per-ISA objects contain nothing but
 // the kernel templates, in an inline namespace named for their ISA
 // (lanes.hpp), and these entry points with ISA-suffixed names: no TBB, no
-// standard-library code that is not inlined (tests/kernel/test_isa_objects
+// standard-library code that is not inlined (tests/core/test_isa_objects.sh
 // checks the objects), so the linker can never pick a wide-ISA copy of a
 // function for a narrow path. One indirect call per block of ~1024 contacts is
 // the whole cost of dispatch.

@@ -4,7 +4,7 @@
 // column order and add the text; the boolean verdicts (body_ok, contact_ok),
 // which the reader's fast path runs on every row, evaluate the same
 // predicates without a branch per value, and the defect finders call them
-// first, so a valid record costs one verdict. tests/kernel/test_rules.cpp
+// first, so a valid record costs one verdict. tests/core/test_rules.cpp
 // checks that verdicts and defects agree.
 #include "collide/rules.hpp"
 

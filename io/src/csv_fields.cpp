@@ -40,7 +40,7 @@ NumberStatus parse_real(std::string_view field, double& value) {
   if (field.empty()) return NumberStatus::empty;
   const char* first = field.data();
   const char* last = first + field.size();
-  // from_chars takes no '+'; the spec's files may well have one ("+inf").
+  // from_chars takes no '+'; a scene file may well have one ("+inf").
   if (*first == '+') {
     ++first;
     if (first == last || *first == '+' || *first == '-') return NumberStatus::syntax;

@@ -1,4 +1,4 @@
-// csv_read.cpp - reading the scene CSV files of the spec: bodies.csv into a
+// csv_read.cpp - reading the scene CSV files of docs/collision-law.md: bodies.csv into a
 // BodyTable, contacts.csv into a ContactBuffer (collide/io/scene_io.hpp).
 //
 // Design notes
@@ -21,7 +21,7 @@
 // * The reader checks the text (numbers, columns, the range of double) and
 //   stores each number as every route stores a scene value: the double
 //   nearest the text, rounded to T (scene_value, refused when it does not
-//   fit T; csv_fields.hpp). The value rules of the spec are rules.hpp's
+//   fit T; csv_fields.hpp). The value rules of docs/collision-law.md are rules.hpp's
 //   (body_ok / contact_ok on the fast path, body_defect / contact_defect
 //   for the message), on the values in T, the precision the kernel will see.
 #include "collide/io/scene_io.hpp"

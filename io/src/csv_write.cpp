@@ -1,4 +1,4 @@
-// csv_write.cpp - writing the scene CSV files of the spec and the result
+// csv_write.cpp - writing the scene CSV files of docs/collision-law.md and the result
 // files: bodies, contacts and impulses, to an OutputFile or to a string, and
 // one row or one number at a time (collide/io/scene_io.hpp).
 //

@@ -2,7 +2,7 @@
 //
 // Every test runs the real binary (COLLIDE_CLI_PATH) in its own directory
 // under the build tree and checks exit codes, messages and files:
-//   * every bad input of the spec: exit 1, a message naming the file, the row
+//   * every bad input of docs/collision-law.md: exit 1, a message naming the file, the row
 //     and the column, and no output file (a pre-existing one untouched);
 //   * gen: same seed, same bytes (whatever the thread count); other seed,
 //     other bytes; the pile is the library's pile, its shuffle a permutation
@@ -119,7 +119,7 @@ class CliTest : public ::testing::Test {
 };
 
 // ---------------------------------------------------------------------------
-// Bad input: every case of the spec.
+// Bad input: every case of docs/collision-law.md, "Bad input".
 // ---------------------------------------------------------------------------
 
 struct BadCase {

@@ -130,7 +130,7 @@ TEST_F(OutputTargetTest, CharacterDeviceIsWrittenNotReplaced) {
   const fs::path node = path("null");
   if (::mknod(node.c_str(), S_IFCHR | 0666, ::makedev(1, 3)) != 0) {
     GTEST_SKIP() << "mknod of a private character device (1, 3) is not permitted here (" << std::strerror(errno)
-                 << "); the device case is untested on this machine";
+                 << "); the device case is untested here";
   }
   struct stat before {};
   ASSERT_EQ(::stat(node.c_str(), &before), 0);

@@ -290,8 +290,9 @@ TEST(LaneIsolation, OverflowingGroundGivesTheSameBitsOnEveryPath) {
 // which one an operation on two NaNs returns depends on the order of its
 // operands, which the compiler chose differently for the scalar and the
 // vector lanes of the sanitizer build (the sphere model, double, accurate
-// mode: -NaN on the scalar path, +NaN on the SIMD one). Every NaN the law
-// writes is now one NaN (canonical_nan, lanes.hpp).
+// mode: -NaN on the scalar path, +NaN on the SIMD one). So every NaN the law
+// writes is one NaN, the positive quiet one (canonical_nan, lanes.hpp;
+// docs/decisions/0030-one-nan-on-every-path.md).
 struct DrawnBody {
   double x[17];  // inv_mass, inverse moments (3), q (4), p, v, w
 };

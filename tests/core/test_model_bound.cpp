@@ -207,7 +207,8 @@ void near_collinear_picks_particle() {
     }
     Scene<T> s = r.scene();
     ASSERT_EQ(chosen(s), Model::particle) << misfit(Model::particle, s);
-    // Not exactly central: the old exact rule would not have fired.
+    // Not exactly central: a rule that asked for r x n = 0 exactly would not
+    // pick the particle model here.
     bool off_centre = false;
     const auto c = s.contacts.view();
     const auto b = s.bodies.view();

@@ -254,7 +254,8 @@ TEST(PackedLayout, AutomaticChoicePacksScatteredScenesOnly) {
   EXPECT_EQ(layout_of(generate_debris<float>(500, g)), BodyLayout::soa);
   // Debris handed over grouped by level: every batch is consecutive contacts,
   // but their bodies are still read at random, so the bodies are packed
-  // (solved in place, the scene ran several times slower than in input order).
+  // (solved in place, such a scene runs several times slower than in input
+  // order).
   Scene<float> grouped = grouped_by_level(generate_debris<float>(20000, g));
   {
     Schedule schedule;

@@ -13,7 +13,8 @@
 //   sysconf, else CPUID (both faked through MachineProbe); a size no source
 //   gives is unknown, never 0; the data cache, not the instruction cache.
 // * The triad's default arrays stay within memory: a reported L3 of 508 MiB
-//   (this VM's sysconf) is capped at physical memory / 32 per array.
+//   (the sysconf of a virtual machine with 24 GiB) is capped at physical
+//   memory / 32 per array.
 #include <unistd.h>
 
 #include <cmath>
@@ -178,7 +179,7 @@ TEST(Bandwidth, NothingKnownIsUnknownNotZero) {
 TEST(Bandwidth, TriadArraysStayWithinMemory) {
   FakeSysfs sysfs("triad_memory");
   MachineProbe p = empty_probe(sysfs);
-  // This VM: sysconf says L3 = 508 MiB, and it has 24 GiB.
+  // A virtual machine whose sysconf says L3 = 508 MiB, with 24 GiB.
   p.sysconf_cache_bytes = [](int level) -> long { return level == 3 ? long{508 * kMiB} : -1L; };
   p.physical_memory_bytes = []() -> std::optional<std::size_t> { return std::size_t{24} << 30; };
   EXPECT_EQ(default_triad_array_bytes(p), (std::size_t{24} << 30) / 32);  // not 4 x 508 MiB
@@ -192,7 +193,8 @@ TEST(Bandwidth, TriadArraysStayWithinMemory) {
   p.sysconf_cache_bytes = [](int level) -> long { return level == 3 ? long{64 * kMiB} : -1L; };
   p.physical_memory_bytes = []() -> std::optional<std::size_t> { return std::size_t{256} << 30; };
   EXPECT_EQ(default_triad_array_bytes(p), 256 * kMiB);
-  // This machine, whatever it reports: three arrays under a tenth of memory.
+  // The machine the test runs on, whatever it reports: three arrays under a
+  // tenth of memory.
   const auto memory = system_probe().physical_memory_bytes();
   ASSERT_TRUE(memory.has_value());
   EXPECT_LE(3 * default_triad_array_bytes(), *memory / 10);

@@ -4,26 +4,23 @@
 // of reference_solve<double> on the debris scenes: no contact above
 // kImpulseErrorTargetEps (2 units).
 //
-// The particle model without friction measured 2.46 (float pairs), 2.63
-// (double pairs), 2.37 (float debris) and 2.77 (double debris) units, a
-// single contact's own rounding, not a chain: hard_attribution put it on the
-// stored normal taken as unit (|n|^2 - 1 up to 1.6 units), the rounding of
-// vn = (va - vb) . n (1.4) and of (1 + e) vn / K (1.8). The fast mode now
-// folds |n|^2 into K and forms the particle's vn and jn in double lanes
-// (float) or compensated (double), rounding jn once
-// (contact_kernel.hpp, fast_normal_impulse): 0.72 to 0.79.
+// Why these scenes: the particle model without friction is where a single
+// contact's own rounding, not a chain, decides. Taking the stored normal as
+// unit and rounding vn = (va - vb) . n and (1 + e) vn / K cost up to 1.4 to
+// 1.8 units each (hard_attribution); so the fast mode folds |n|^2 into K and
+// forms the particle's vn and jn in double lanes (float) or compensated
+// (double), rounding jn once (contact_kernel.hpp, fast_normal_impulse; the
+// figures: docs/decisions/0010-the-fast-modes-normal-impulse.md).
 //
-// With friction the debris scene measured 7.6 units in double and 6.0 in
-// float, and reference_solve<double> (the plainest evaluation of the law)
-// 7.2, so the unit, not the kernels' order of operations, was short. The
-// worst contact was the first on both of its bodies, so not a chain: its
-// friction step read the velocities left by its own normal impulse, whose
-// rounding (relative to max(1/I) |r| jn, with |r| = 47 m on a body with
-// moments 1:62) the scale did not count. The scale now does (reference.cpp,
-// `after_normal`; docs/collision-law.md, "The friction step after the
-// normal impulse"), and the friction cases are within the target. Counting
-// the rounding of every velocity update along chains instead (|v'|/2 per
-// update) was tried first and changed nothing (7.2).
+// With friction, the debris scene's worst contact is the first on both of
+// its bodies, so not a chain: its friction step reads the velocities left by
+// its own normal impulse, whose rounding (relative to max(1/I) |r| jn, large
+// for a long lever on a body with unequal moments) the impulse scale counts
+// (reference.cpp, `after_normal`; docs/collision-law.md, "The friction step
+// after the normal impulse"; the figures:
+// docs/decisions/0008-the-impulse-scale.md). reference_solve<double>, the
+// plainest evaluation of the law, is held to the same unit, so a unit that
+// is short shows there and not only in the kernels.
 //
 // Mutations checked: without `after_normal`, ReferenceDoubleOnDebris and
 // KernelsOnDebrisDouble fail with friction; with fast_normal_impulse's

@@ -11,12 +11,11 @@
 //   first one's velocity and the others stop; listed last to first, only
 //   the first two spheres exchange velocity (the order is the input's, not
 //   the geometry's); momentum is conserved and, for e = 1, energy too. Every
-//   cradle is within the fast mode's target: along a random axis the float
-//   cradle with mixed masses measured 2.37 units while the kernels took the
-//   stored normal (unit only to a few eps) as unit, which scaled each link's
-//   impulse by |n|^2 and passed the factor down the chain (hard_attribution:
-//   the n term alone 1.2 units); fast_normal_impulse now folds |n|^2 into K
-//   (1.15 units).
+//   cradle is within kImpulseErrorTargetEps: along a random axis every link
+//   has the same stored normal, unit only to a few eps, and a kernel that
+//   took it as unit would scale each link's impulse by |n|^2 and pass the
+//   factor down the chain; fast_normal_impulse folds |n|^2 into K
+//   (docs/decisions/0010-the-fast-modes-normal-impulse.md).
 // * A star (one body in 1000 contacts, movable or immovable): the bound on
 //   every contact along the 1000-long chain, conservation, 1000 batches for
 //   a movable hub and one for an immovable one.

@@ -1,5 +1,5 @@
-// test_npz.cpp - npz.cpp: the .npy header parser, the archive reader and the
-// writer.
+// test_npz.cpp - the .npy header parser (npy_header.cpp), the archive reader
+// (npz_read.cpp) and the writer (npz_write.cpp).
 //
 // The archives the refusal tests need (a deflated member, a local header
 // whose extra field differs from the central entry's, ZIP64 fields, an end

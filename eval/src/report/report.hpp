@@ -106,7 +106,7 @@ struct SweepPoint {
   double bandwidth_fraction = 0;
 };
 
-/// What Isa::automatic picks on this machine for one kind of solve
+/// What Isa::automatic picks on the machine of the run for one kind of solve
 /// (collide::fastest_isa, measured in the report's own process).
 struct IsaAutoPick {
   std::string precision;           ///< "float" or "double"

@@ -10,8 +10,8 @@
 // * Speed: each variant solves the full scene (--n collisions) `runs` times;
 //   before each run the velocities are restored from a saved copy, untimed,
 //   and only the solve call is timed (Solver::solve for the kernel). The
-//   median run is the row's speed, so one run disturbed by another process on
-//   this shared machine does not move it. The schedule is built once per
+//   median run is the row's speed, so one run disturbed by another process
+//   does not move it. The schedule is built once per
 //   scene, as a user solving every frame would do.
 // * The bandwidth bound: collisions/s x bytes_per_collision(model, sizeof(T),
 //   friction) (traffic.hpp) / triad bandwidth (bandwidth.hpp) measured at the

@@ -11,7 +11,7 @@ into DIR and prints the stats as one JSON line; ``scenes`` writes the table
 as CSV (to stdout without --out). A spec file is a JSON list of scenes, each
 the parameters of collide.generate ({"kind": "pairs", "n": 10000, "seed": 3})
 or a file pair ({"bodies": "b.npz", "contacts": "c.npz"}, paths relative to
-the spec file). Progress goes to stderr: dask.distributed.progress on a
+the JSON file). Progress goes to stderr: dask.distributed.progress on a
 terminal, a line per finished task otherwise.
 
 Exit codes: 0 done; 1 bad input or a failed run (the message names the file,

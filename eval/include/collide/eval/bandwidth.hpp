@@ -63,7 +63,7 @@ struct MachineProbe {
   std::function<std::optional<std::size_t>()> physical_memory_bytes;
 };
 
-/// The real sources of this machine.
+/// The real sources of the machine the process runs on.
 MachineProbe system_probe();
 
 /// The cache size of `level` (1, 2, 3, 4): /sys, else sysconf, else CPUID.

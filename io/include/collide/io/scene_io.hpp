@@ -1,4 +1,5 @@
-// collide/io/scene_io.hpp - reading and writing the scene CSV files of the spec.
+// collide/io/scene_io.hpp - reading and writing the scene CSV files of
+// docs/collision-law.md.
 //
 // Design notes
 // ------------
@@ -8,9 +9,10 @@
 //   masses and unit quaternions (`to_body_buffer`), but the result file must
 //   copy every column other than v and w unchanged, so the writer takes the
 //   table and the solved velocities.
-// * Every bad input of the spec is a SceneError whose message names the file,
-//   the 1-based line, the 0-based data row (the body or contact id) and the
-//   column: "bodies.csv:5: row 3, column 'm': mass must be > 0, got -1".
+// * Every bad input docs/collision-law.md lists ("Bad input") is a SceneError
+//   whose message names the file, the 1-based line, the 0-based data row (the
+//   body or contact id) and the column:
+//   "bodies.csv:5: row 3, column 'm': mass must be > 0, got -1".
 //   What the text itself gets wrong (not a number, an empty field, a missing
 //   or extra column, a number beyond the range of double) is the reader's to
 //   say; each number is the double nearest its text, stored in T as every

@@ -34,6 +34,8 @@ namespace buffers_detail {
 // overloads, and numeric_limits knows it only in GNU mode).
 template <class T>
 bool is_infinite(T x) {
+  // x == x fails only for NaN, x - x == x - x only for inf and NaN.
+  // NOLINTNEXTLINE(misc-redundant-expression): both sides are the same on purpose
   return x == x && !(x - x == x - x);
 }
 template <class T>

@@ -1,0 +1,45 @@
+# cmake/flags.cmake - the compiler flags of collide's own code, included by
+# the top-level CMakeLists.txt after cmake/options.cmake.
+#
+#   collide_build_flags      an INTERFACE target every target of the project
+#                            links (PRIVATE, and only in the build: it is never
+#                            installed or exported): the floating-point policy
+#                            and the warnings
+#   COLLIDE_ISA_FLAGS_<isa>  the flags of one kernel ISA (sse2, avx2, avx512),
+#                            for the per-ISA kernel objects (core/) and the
+#                            per-ISA tests of the lane layer (tests/)
+#
+# Everything outside the per-ISA kernels is compiled for the target's
+# baseline: no -march=native anywhere.
+
+# ---------------------------------------------------------------------------
+# Floating-point policy (tested per ISA in tests/core/test_fp_policy.cpp):
+#   * -ffp-contract=off: a*b+c is never fused, so the scalar path, the SSE2
+#     path and the AVX2 path perform the same IEEE operations in the same
+#     order and agree bit for bit (docs/collision-law.md, "Precision and the
+#     error bound").
+#   * no -ffast-math, -fno-finite-math etc.: NaN and inf keep their meaning,
+#     divisions and square roots are correctly rounded.
+# ---------------------------------------------------------------------------
+set(COLLIDE_FP_FLAGS -ffp-contract=off -fno-fast-math)
+
+add_library(collide_build_flags INTERFACE)
+target_compile_options(collide_build_flags INTERFACE ${COLLIDE_FP_FLAGS} -Wall -Wextra -Wpedantic)
+
+# ---------------------------------------------------------------------------
+# The kernel ISAs (which ones are built: COLLIDE_KERNEL_ISAS, cmake/options.cmake).
+# The results are bitwise identical across all of them (the floating-point
+# policy above): the ISA changes speed, never answers.
+# ---------------------------------------------------------------------------
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
+  set(COLLIDE_ISA_FLAGS_sse2 -msse2)
+  # -mno-fma on AVX2, on purpose: no fused multiply-add instruction exists
+  # there to appear.
+  set(COLLIDE_ISA_FLAGS_avx2 -mavx2 -mno-fma)
+  # No -mno-fma here: AVX-512F includes FMA, and clang drops AVX-512 altogether
+  # under -mno-fma (its 16-lane "AVX-512" object was then AVX2 code). No FMA
+  # can appear anyway: -ffp-contract=off forbids contraction and the code
+  # never calls an fma. -mprefer-vector-width=512: clang would otherwise split
+  # 16-lane vectors into two ymm halves.
+  set(COLLIDE_ISA_FLAGS_avx512 -mavx512f -mavx512bw -mavx512dq -mavx512vl -mprefer-vector-width=512)
+endif()
