@@ -14,6 +14,8 @@
 //     textbook/<scene>/<prec>/t:1/n:N     the plain Eigen loop (textbook.hpp), N <= 4Mi
 //   then, at 64Ki and 4Mi in float, for pairs, debris, pile, pile+shuffle and chain:
 //     schedule/<scene>/f32/colour/n:N     Schedule::build in the colour order
+//     order_twin/<scene>/f32/<input|colour>/t:2/n:N   the packed twin
+//                                    (packed_twin.hpp) in that order's schedule
 //     order/<scene>/f32/<input|colour>/passes:{1,4}/t:{1,2}/n:N   a solve in
 //                                    that order; the rate counts every pass
 //   then the piles' groups (pile, pile+shuffle) at the largest pile within
@@ -206,6 +208,9 @@ void register_rows(const Options& options, std::size_t file_contacts) {
                     [=](benchmark::State& s) { order_row<float>(s, kind, size, order, passes, threads); });
           }
         }
+        // The order's memory-only twin: the ceiling of its index pattern.
+        add_row(order_twin_name(kind, "f32", order, 2, size),
+                [=](benchmark::State& s) { order_twin_row<float>(s, kind, size, order, 2); });
       }
     }
   }

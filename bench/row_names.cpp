@@ -70,4 +70,9 @@ std::string order_name(Kind kind, const char* precision, collide::Order order, i
          "/passes:" + std::to_string(passes) + threads_and_n(threads, n);
 }
 
+std::string order_twin_name(Kind kind, const char* precision, collide::Order order, int threads, std::size_t n) {
+  return std::string("order_twin/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(order) +
+         threads_and_n(threads, n);
+}
+
 }  // namespace collide_bench

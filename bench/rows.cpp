@@ -303,6 +303,28 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
                  std::to_string(stats.colours) + " colours, " + std::to_string(stats.overflow_contacts) + " overflow");
 }
 
+/// The packed twin (packed_twin.hpp: every byte the solve reads and writes,
+/// none of the law) on rigid records, walked in the given order's schedule:
+/// the memory-only ceiling of that order's index pattern.
+template <class T>
+void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int threads) {
+  Prepared<T>& p = prepared_scene<T>(kind, n);
+  collide::Schedule schedule(order);
+  schedule.build(p.contacts(), p.bodies(), threads);
+  oneapi::tbb::task_arena arena(threads);
+  arena.initialize();
+  collide::PackedBuffer<collide::PackedRigid<T>> records(p.bodies().count);
+  pack_as(p.bodies(), collide::packed_view(records));
+  const collide::ContactView<T> contacts = p.contacts();
+  const collide::ImpulseView<T> impulses = p.impulses.view();
+  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule);  // sizes its buffers
+  const double seconds = timed_solves(
+      state, p, [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule); });
+  Columns columns = solve_columns(n, bytes_per_collision<T>(p.friction), seconds, threads);
+  columns.batches = static_cast<double>(schedule.batch_count());
+  set_counters(state, columns);
+}
+
 #define COLLIDE_BENCH_ROWS(T)                                                                                     \
   template void solve_row<T>(benchmark::State&, Kind, std::size_t, Path, int, collide::Isa);                      \
   template void model_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, bool, int, collide::Accuracy); \
@@ -311,7 +333,8 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
   template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
   template void schedule_row<T>(benchmark::State&, Kind, std::size_t, collide::Order);                            \
-  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);
+  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);                    \
+  template void order_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int);
 COLLIDE_BENCH_ROWS(float)
 COLLIDE_BENCH_ROWS(double)
 #undef COLLIDE_BENCH_ROWS

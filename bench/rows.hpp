@@ -51,5 +51,9 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
 /// in `order` with `passes` passes; the rate counts every pass's contacts.
 template <class T>
 void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads);
+/// order_twin/<scene>/f32/<order>/t:T/n:N: the packed twin walked in that
+/// order's schedule (rows.cpp).
+template <class T>
+void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int threads);
 
 }  // namespace collide_bench

@@ -10,7 +10,15 @@
 #      tests are left out; the latter
 #      install the library and build consumers without sanitizer flags (which
 #      cannot link a sanitized archive) and recompile the library, and the
-#      Release stage has run them already.
+#      Release stage has run them already. So are the `report` tests (two
+#      whole `collide report` runs, minutes under the sanitizers; the Release
+#      stage runs them, and the report's code runs here in
+#      CliNpzTest.ReportMeasuresAScenesFiles and the eval tests).
+#      The sanitized builds compile one kernel, the baseline's
+#      (COLLIDE_KERNEL_ISAS=sse2: 4 float and 2 double lanes, and the
+#      one-lane kernel of every path): the kernel is one body over the lane
+#      type (kernel_isa.cpp), so a wider copy adds minutes of compile time
+#      and no code of its own, and the Release stage runs every ISA's.
 #   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 45),
 #      the targets side by side on the available cores, from a scratch copy of
 #      fuzz/corpus/<target>/ (the committed seeds stay as they are). A crash,
@@ -47,13 +55,13 @@ stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
 asan="$root/build-asan"
 stage "ASan+UBSan build"
 cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" \
-  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON \
+  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON -DCOLLIDE_KERNEL_ISAS=sse2 \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$asan" -j"$jobs"
 stage "ASan+UBSan tests"
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE "package|objects"
+ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE "package|objects|report"
 
 # --- 2. Fuzzing -------------------------------------------------------------
 stage "fuzzing, ${fuzz_seconds}s per target"
@@ -84,6 +92,7 @@ done
 tsan="$root/build-tsan"
 stage "TSan build"
 cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" -DCOLLIDE_SANITIZE=thread \
+  -DCOLLIDE_KERNEL_ISAS=sse2 \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_islands test_solver_arena \
   test_hard_shared collide_itt_tsan collide_race_canary

@@ -86,7 +86,12 @@ std::string value_reason(std::size_t k, T v, ValueFault fault) {
     case ValueFault::inf:
       return inf_reason(number(v));
     case ValueFault::not_positive:
-      return std::string(what) + " must be > 0, got " + number(v);
+      // A zero names what the caller probably meant: inf, the immovable
+      // body or the locked axis.
+      return std::string(what) + " must be > 0, got " + number(v) +
+             (v != T(0)      ? ""
+              : k == kMass ? " (an immovable body has m = inf)"
+                           : " (a locked axis has moment inf)");
     case ValueFault::inverse_overflows:
       return std::string(what) + " " + number(v) + " is too small: its inverse overflows " + precision_name<T>();
     case ValueFault::none:

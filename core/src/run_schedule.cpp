@@ -116,9 +116,11 @@ class Walk {
     const std::size_t w = plan_.width;
     const std::size_t per_item = ((end - begin + s.items - 1) / s.items + w - 1) / w * w;
     const std::size_t b = begin + item * per_item;
-    if (b < end) kernel_(job, schedule_.batch_is_contiguous(k), b, std::min(end, b + per_item));
+    if (b < end) kernel_(job, consecutive(k), b, std::min(end, b + per_item));
   }
 
+  /// Batch k's contacts are consecutive in the job's arrays.
+  [[nodiscard]] bool consecutive(std::size_t k) const { return plan_.prepared || schedule_.batch_is_contiguous(k); }
   /// A contact or a few per batch: shorter than the lanes (SIMD), or every
   /// batch of a serial step (the one-lane kernel walks contacts in order).
   [[nodiscard]] bool runs_alone(std::size_t n) const { return !plan_.simd || n < plan_.width; }
@@ -136,7 +138,7 @@ class Walk {
       }
       const std::size_t stop = schedule_.batch_begin(last);
       if (last == k + 1) {
-        kernel_(job, schedule_.batch_is_contiguous(k), begin, stop);
+        kernel_(job, consecutive(k), begin, stop);
       } else if (!plan_.simd) {
         solve_range_scalar<T>(job, false, begin, stop);
       } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction &&

@@ -41,6 +41,9 @@ struct WalkPlan {
   std::size_t width = 1;   ///< lanes of the kernel that runs
   std::size_t block = 1;   ///< contacts per item of a large batch (a multiple of width)
   std::size_t passes = 1;  ///< times the schedule is walked; J is summed over them
+  /// The job's contacts are in the schedule's order (prepared_contacts.hpp):
+  /// every batch's contacts are consecutive in its arrays.
+  bool prepared = false;
 };
 
 /// Resolves every contact of `schedule` `plan.passes` times with `job`'s

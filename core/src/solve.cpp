@@ -15,7 +15,7 @@
 //   picks the table per solve: the fastest ISA for the solve's model,
 //   precision, accuracy and scene kind (isa_calibration.hpp), a cached
 //   lookup after the first solve of that kind in the process.
-// * Nothing here allocates once the packing buffer is sized: the Solver owns
+// * Nothing here allocates once the packing and prepared buffers are sized: the Solver owns
 //   its task_arena (or borrows the caller's, collide/tbb.hpp), the Schedule
 //   owns the order.
 #include <cassert>
@@ -31,6 +31,7 @@
 #include "collide/tbb.hpp"
 #include "collide/validate.hpp"
 #include "kernel_table.hpp"
+#include "prepared_contacts.hpp"
 #include "run_schedule.hpp"
 #include "scratch_records.hpp"
 #include "solve_policy.hpp"
@@ -53,6 +54,21 @@ struct Solver::Impl {
   detail::ScratchRecords<PackedSphere<double>> sphere_d;
   detail::ScratchRecords<PackedParticle<float>> particle_f;
   detail::ScratchRecords<PackedParticle<double>> particle_d;
+
+  // Where a colour-order solve copies its contacts (prepared_contacts.hpp);
+  // such solves on one Solver take turns.
+  std::mutex prepare_mutex;
+  detail::PreparedContacts<float> prepared_f;
+  detail::PreparedContacts<double> prepared_d;
+
+  template <class T>
+  detail::PreparedContacts<T>& prepared() {
+    if constexpr (std::is_same_v<T, float>) {
+      return prepared_f;
+    } else {
+      return prepared_d;
+    }
+  }
 
   template <class Record>
   detail::ScratchRecords<Record>& buffer() {
@@ -94,9 +110,11 @@ struct Solver::Impl {
         kernels(detail::fixed_kernels(o.isa, isa_choice)),
         arena(&borrowed) {}
 
-  /// Runs the job's contacts over the schedule with the picked kernels.
+  /// Runs the job's contacts over the schedule with the picked kernels: on
+  /// the caller's contacts, or on contacts prepared in the schedule's order
+  /// (detail::prepares_contacts).
   template <class T>
-  SolveStats run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule) const;
+  SolveStats run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule);
 };
 
 namespace {
@@ -132,14 +150,29 @@ const SolverOptions& Solver::options() const { return impl_->options; }
 
 template <class T>
 SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJob<T>& job,
-                             const Schedule& schedule) const {
+                             const Schedule& schedule) {
   const detail::KernelTable& table = *pick.kernels;
   detail::WalkPlan plan;
   plan.simd = options.path == Path::simd;
   plan.width = plan.simd ? detail::of_precision<T>(table.lanes_float, table.lanes_double) : 1;
   plan.block = std::max<std::size_t>(plan.width, (options.block + plan.width - 1) / plan.width * plan.width);
   plan.passes = static_cast<std::size_t>(options.passes);
-  detail::walk_schedule(table, plan, *arena, job, schedule);
+  if (detail::prepares_contacts(schedule)) {
+    // Copied in, walked every pass, J copied out: the copies cost two
+    // streaming passes, the gathers they spare one per colour.
+    const std::lock_guard<std::mutex> lock(prepare_mutex);
+    detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
+    prepared_contacts.prepare(*arena, job.contacts, schedule.order());
+    detail::KernelJob<T> on_prepared = job;
+    on_prepared.contacts = prepared_contacts.contacts();
+    on_prepared.impulses = prepared_contacts.impulses();
+    on_prepared.order = prepared_contacts.identity();
+    plan.prepared = true;
+    detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
+    prepared_contacts.write_back(*arena, job.impulses, schedule.order());
+  } else {
+    detail::walk_schedule(table, plan, *arena, job, schedule);
+  }
 
   SolveStats stats;
   stats.contacts = job.contacts.count;
@@ -325,8 +358,9 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   const detail::IsaPick pick =
       detail::pick_isa<T>(impl_->options, impl_->isa_choice, impl_->kernels, model,
                           detail::scattered_contacts(schedule, contacts.a, contacts.b), schedule.contact_count());
-  // The caller's records are solved in place: no buffer of the solver's is
-  // used, so solves on one Solver may run at once, as on SoA views.
+  // The caller's records are solved in place: no packing buffer of the
+  // solver's is used, so solves on one Solver may run at once, as on SoA
+  // views (colour-order ones take turns over the prepared contacts).
   return impl_->run(pick, job, schedule);
 }
 

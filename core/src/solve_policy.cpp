@@ -53,6 +53,14 @@ template IsaPick pick_isa<double>(const SolverOptions&, IsaChoice, const KernelT
 /// spaced places, and count as scattered when most samples find both bodies
 /// far from those of the contact before. The sample reads a few hundred
 /// indices: nothing beside the solve.
+bool prepares_contacts(const Schedule& schedule) {
+  if (schedule.ordering() != Order::colour) return false;
+  for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
+    if (!schedule.batch_is_contiguous(k)) return true;
+  }
+  return false;
+}
+
 std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b) {
   std::size_t n = 0;
   const std::uint32_t* order = schedule.order();

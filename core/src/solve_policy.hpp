@@ -42,6 +42,12 @@ IsaPick pick_isa(const SolverOptions& options, IsaChoice choice, const KernelTab
 /// batches whose bodies, sampled, do not follow one another.
 std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b);
 
+/// Whether a solve over `schedule` copies its contacts into the schedule's
+/// order first (prepared_contacts.hpp): in the colour order, when a batch is
+/// not consecutive contacts of the input. (A colour order of consecutive
+/// batches, pairs', reads the caller's arrays as they are.)
+bool prepares_contacts(const Schedule& schedule);
+
 /// Whether SoA input of `bodies` bodies, `scattered` of whose contacts reach
 /// them at random, is packed (BodyLayout::automatic), or what `layout` forces.
 bool should_pack(BodyLayout layout, std::size_t scattered, std::size_t bodies);

@@ -447,12 +447,17 @@ ImpulseBuffer<T> load_impulses(const std::string& path, SceneFormat format) {
   ImpulseBuffer<T> out(members[0]->count);
   const ImpulseView<T> j = out.view();
   T* const into[3] = {j.j.x, j.j.y, j.j.z};
+  std::optional<RowDefect> range;
   for (std::size_t k = 0; k < kImpulseColumns.size(); ++k) {
     std::vector<T> owned;
     bool in_place = false;
-    const T* column = real_column<T>(archive, *members[k], precision, owned, in_place);
+    std::size_t out_of_range = j.count;
+    const T* column = real_column<T>(archive, *members[k], precision, owned, in_place, out_of_range);
+    keep_first_out_of_range<T>(range, *members[k], kImpulseColumns[k], out_of_range);
     std::copy(column, column + j.count, into[k]);
   }
+  // An impulse beyond T's range, as a scene value would be: refused at its row.
+  if (range) throw SceneError(archive.file_name(), 0, range->row, std::string(range->defect.column), range->defect.reason);
   return out;
 }
 

@@ -194,19 +194,9 @@ py::object from_physical_py(const py::object& m_in, const py::object& inertia_in
       defect = first_body_defect(columns);
     }
     if (defect) {
-      // What fixes a zero mass or moment in physical units: inf is the
-      // immovable body, and the locked axis.
       const std::string column(defect->defect.column);
-      const std::string& why = defect->defect.reason;
-      const auto ends_with = [&](std::string_view tail) {
-        return why.size() >= tail.size() && why.compare(why.size() - tail.size(), tail.size(), tail) == 0;
-      };
-      const bool zero = ends_with(" must be > 0, got 0") || ends_with(" must be > 0, got -0");
-      const std::string fix = !zero           ? ""
-                              : column == "m" ? " (an immovable body has m = inf)"
-                                              : " (a locked axis has moment inf)";
       throw py::value_error(owner + ": body " + std::to_string(defect->row) + ", column '" + column +
-                            "': " + defect->defect.reason + fix);
+                            "': " + defect->defect.reason);
     }
     const auto [inv_mass, inv_inertia] = inverse_arrays(columns, d);
     const auto copy = [&](std::size_t first, std::size_t rows) {

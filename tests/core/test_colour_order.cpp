@@ -27,6 +27,7 @@
 #include <limits>
 #include <numeric>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -84,6 +85,8 @@ Scene<T> make_scene(Kind kind, std::size_t contacts, bool friction, Model model 
       return s;
     }
     case Kind::shared:
+      // Rigid bodies only: a smaller model would not fit them.
+      if (model != Model::rigid) throw std::logic_error("the shared scene has rigid bodies only");
       break;
   }
   SceneOptions so;
@@ -334,9 +337,13 @@ TEST_P(ColourSolve, IsTheLawSequentiallyInItsOrderOnEveryPath) {
     expect_sequential_law<float>(p, Model::rigid, accuracy);
     expect_sequential_law<double>(p, Model::rigid, accuracy);
   }
-  // The smaller models on their own scenes.
-  expect_sequential_law<float>(p, Model::sphere, Accuracy::fast);
-  expect_sequential_law<double>(p, Model::particle, Accuracy::fast);
+  // The smaller models on their own scenes: the generators make them for every
+  // kind but the shared one, whose bodies are rigid (tests/support/scenes.hpp);
+  // the sphere and particle kernels meet shared bodies in the debris and pile.
+  if (p.kind != Kind::shared) {
+    expect_sequential_law<float>(p, Model::sphere, Accuracy::fast);
+    expect_sequential_law<double>(p, Model::particle, Accuracy::fast);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ColourSolve,

@@ -688,7 +688,7 @@ TEST_F(SceneRoutes, SubnormalsTheRulesRefuseAreRefusedByEveryRouteWithOneMessage
               "moment of inertia " + collide::test::shortest_text(sub) + " is too small: its inverse overflows float"});
   // A mass that rounds to 0 in float.
   expect_every_float_route_refuses(dir_, bodies_text(2, {{1, kM, "1e-46"}}),
-                                   Refusal{1, "m", "mass must be > 0, got 0"});
+                                   Refusal{1, "m", "mass must be > 0, got 0 (an immovable body has m = inf)"});
   // A quaternion whose |q|^2 is subnormal in float.
   expect_every_float_route_refuses(
       dir_, bodies_text(2, {{1, kQw, "1e-20"}, {1, kQx, "3e-21"}}),

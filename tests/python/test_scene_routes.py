@@ -219,7 +219,8 @@ def test_subnormals_the_rules_refuse_are_refused_by_every_route_with_one_reason(
     number = re.fullmatch(r"moment of inertia (\S+) is too small: its inverse overflows float", got["read_scene"][1])
     assert number and np.float32(number.group(1)) == even, got["read_scene"]
     expect_one_reason(got, 1, "Iy", got["read_scene"][1])
-    expect_one_reason(refusals(cli, workdir, body_rows({(1, "m"): "1e-46"})), 1, "m", "mass must be > 0, got 0")
+    expect_one_reason(refusals(cli, workdir, body_rows({(1, "m"): "1e-46"})), 1, "m",
+                      "mass must be > 0, got 0 (an immovable body has m = inf)")
     expect_one_reason(refusals(cli, workdir, body_rows({(1, "qw"): "1e-20", (1, "qx"): "3e-21"})), 1, "qw",
                       "quaternion cannot be normalised in float: it is too close to zero "
                       "(qw, qx, qy, qz = 1e-20, 3e-21, 0, 0)")

@@ -1,0 +1,104 @@
+// prepared_contacts.cpp - the copies of prepared_contacts.hpp.
+#include "prepared_contacts.hpp"
+
+#include <numeric>
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/partitioner.h>
+
+namespace collide::detail {
+namespace {
+
+/// Contacts per task of a copy: long stretches, so that each thread streams
+/// through its part of the prepared arrays.
+constexpr std::size_t kGrain = 16384;
+
+/// f(begin, end) over [0, n) on the arena's threads, each thread one
+/// contiguous part.
+template <class F>
+void for_parts(tbb::task_arena& arena, std::size_t n, const F& f) {
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, kGrain),
+        [&](const tbb::blocked_range<std::size_t>& r) { f(r.begin(), r.end()); }, tbb::static_partitioner());
+  });
+}
+
+/// to[i] = from[order[i]] for i in [begin, end).
+template <class V>
+void gather(V* to, const V* from, const std::uint32_t* order, std::size_t begin, std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) to[i] = from[order[i]];
+}
+
+}  // namespace
+
+template <class T>
+void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& contacts,
+                                  const std::uint32_t* order) {
+  const std::size_t n = contacts.count;
+  // The point only where the model reads it: a particle solve may have none.
+  const bool point = contacts.c.x != nullptr && contacts.c.y != nullptr && contacts.c.z != nullptr;
+  // Sized to n: a ScratchVector keeps its capacity, and a smaller solve
+  // after a larger one neither allocates nor touches new pages.
+  a_.resize(n);
+  b_.resize(n);
+  for (int k = 0; k < 3; ++k) {
+    if (point) c_[k].resize(n);
+    n_[k].resize(n);
+    j_[k].resize(n);
+  }
+  if (contacts.e != nullptr) e_.resize(n);
+  if (contacts.mu != nullptr) mu_.resize(n);
+  if (identity_.size() < n) {
+    const std::size_t from = identity_.size();
+    identity_.resize(n);
+    std::iota(identity_.begin() + static_cast<std::ptrdiff_t>(from), identity_.end(), static_cast<std::uint32_t>(from));
+  }
+
+  ContactView<T> v;
+  v.count = n;
+  v.a = a_.data();
+  v.b = b_.data();
+  v.n = {n_[0].data(), n_[1].data(), n_[2].data()};
+  if (point) v.c = {c_[0].data(), c_[1].data(), c_[2].data()};
+  v.e = contacts.e != nullptr ? e_.data() : nullptr;
+  v.uniform_e = contacts.uniform_e;
+  v.mu = contacts.mu != nullptr ? mu_.data() : nullptr;
+  view_ = v;
+  impulses_.count = n;
+  impulses_.j = {j_[0].data(), j_[1].data(), j_[2].data()};
+
+  for_parts(arena, n, [&](std::size_t begin, std::size_t end) {
+    gather(a_.data(), contacts.a, order, begin, end);
+    gather(b_.data(), contacts.b, order, begin, end);
+    if (point) {
+      gather(c_[0].data(), contacts.c.x, order, begin, end);
+      gather(c_[1].data(), contacts.c.y, order, begin, end);
+      gather(c_[2].data(), contacts.c.z, order, begin, end);
+    }
+    gather(n_[0].data(), contacts.n.x, order, begin, end);
+    gather(n_[1].data(), contacts.n.y, order, begin, end);
+    gather(n_[2].data(), contacts.n.z, order, begin, end);
+    if (contacts.e != nullptr) gather(e_.data(), contacts.e, order, begin, end);
+    if (contacts.mu != nullptr) gather(mu_.data(), contacts.mu, order, begin, end);
+  });
+}
+
+template <class T>
+void PreparedContacts<T>::write_back(tbb::task_arena& arena, const ImpulseView<T>& impulses,
+                                     const std::uint32_t* order) const {
+  for_parts(arena, impulses_.count, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t k = order[i];
+      impulses.j.x[k] = impulses_.j.x[i];
+      impulses.j.y[k] = impulses_.j.y[i];
+      impulses.j.z[k] = impulses_.j.z[i];
+    }
+  });
+}
+
+template class PreparedContacts<float>;
+template class PreparedContacts<double>;
+
+}  // namespace collide::detail

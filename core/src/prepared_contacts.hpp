@@ -1,0 +1,65 @@
+// prepared_contacts.hpp - the contacts copied into the schedule's order
+// before a colour-order solve, and J copied back after it (private to the
+// library; solve.cpp).
+//
+// Design notes
+// ------------
+// * Why: a colour of a window holds every few contacts of a stretch of the
+//   input, so a kernel that reads the caller's arrays through the order
+//   loads each of their lines once per colour, as a gather of W lanes per
+//   field. Copied in solve order, every batch's contacts are consecutive:
+//   the kernel loads each field as one vector (its `contiguous` case) and
+//   writes J the same way, and the copies themselves are two streaming
+//   passes, shared by every pass of SolverOptions::passes. Box2D stores its
+//   contact constraints per colour for the same reason (constraint_graph.c);
+//   Bepu prepares them into bundles per batch (TypeBatch).
+// * What: a, b, the point (when the model reads it), n, e (unless uniform),
+//   mu (with friction) and J, one array each, in the order's positions;
+//   and `identity` (0, 1, 2, ...), the order of the prepared arrays, for the
+//   paths that walk an order (a run of tiny batches). In float that is at
+//   most 56 bytes a contact; the arrays grow to the largest solve and are
+//   kept, and each is written in full by the prepare before anything reads
+//   it (ScratchVector leaves new elements uninitialised).
+// * The bits: the law reads the same values in the same sequence, so the
+//   result is the same as through the order (tests/core/test_colour_order.cpp
+//   holds every path to the sequential law).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <oneapi/tbb/task_arena.h>
+
+#include "collide/contacts.hpp"
+#include "scratch_vector.hpp"
+
+namespace collide::detail {
+
+template <class T>
+class PreparedContacts {
+ public:
+  /// Copies contacts order[0], order[1], ... (contacts.count of them) into
+  /// the prepared arrays, on the threads of `arena`. Allocates only when the
+  /// count exceeds every count before.
+  void prepare(tbb::task_arena& arena, const ContactView<T>& contacts, const std::uint32_t* order);
+
+  /// The prepared contacts, their J (written by the solve) and their order.
+  [[nodiscard]] ContactView<T> contacts() const { return view_; }
+  [[nodiscard]] ImpulseView<T> impulses() const { return impulses_; }
+  [[nodiscard]] const std::uint32_t* identity() const { return identity_.data(); }
+
+  /// J of position i to impulses[order[i]], for every prepared contact.
+  void write_back(tbb::task_arena& arena, const ImpulseView<T>& impulses, const std::uint32_t* order) const;
+
+ private:
+  ScratchVector<BodyIndex> a_, b_;
+  ScratchVector<T> c_[3], n_[3], e_, mu_, j_[3];
+  ScratchVector<std::uint32_t> identity_;
+  ContactView<T> view_;
+  ImpulseView<T> impulses_;
+};
+
+extern template class PreparedContacts<float>;
+extern template class PreparedContacts<double>;
+
+}  // namespace collide::detail
