@@ -333,7 +333,7 @@ void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::
   template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
   template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
   template void schedule_row<T>(benchmark::State&, Kind, std::size_t, collide::Order);                            \
-  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);                    \
+  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);                     \
   template void order_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int);
 COLLIDE_BENCH_ROWS(float)
 COLLIDE_BENCH_ROWS(double)

@@ -34,8 +34,7 @@ void gather(V* to, const V* from, const std::uint32_t* order, std::size_t begin,
 }  // namespace
 
 template <class T>
-void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& contacts,
-                                  const std::uint32_t* order) {
+void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& contacts, const std::uint32_t* order) {
   const std::size_t n = contacts.count;
   // The point only where the model reads it: a particle solve may have none.
   const bool point = contacts.c.x != nullptr && contacts.c.y != nullptr && contacts.c.z != nullptr;

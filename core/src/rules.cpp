@@ -89,7 +89,7 @@ std::string value_reason(std::size_t k, T v, ValueFault fault) {
       // A zero names what the caller probably meant: inf, the immovable
       // body or the locked axis.
       return std::string(what) + " must be > 0, got " + number(v) +
-             (v != T(0)      ? ""
+             (v != T(0)    ? ""
               : k == kMass ? " (an immovable body has m = inf)"
                            : " (a locked axis has moment inf)");
     case ValueFault::inverse_overflows:

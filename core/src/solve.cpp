@@ -149,8 +149,7 @@ Solver& Solver::operator=(Solver&&) noexcept = default;
 const SolverOptions& Solver::options() const { return impl_->options; }
 
 template <class T>
-SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJob<T>& job,
-                             const Schedule& schedule) {
+SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule) {
   const detail::KernelTable& table = *pick.kernels;
   detail::WalkPlan plan;
   plan.simd = options.path == Path::simd;

@@ -129,14 +129,16 @@ std::vector<BodyCase<T>> body_cases() {
   add(
       "zero_m", [&](BodyRecord<T>& b) { b.m = T(0); }, "m", "mass must be > 0, got 0 (an immovable body has m = inf)");
   add(
-      "minus_zero_m", [&](BodyRecord<T>& b) { b.m = -T(0); }, "m", "mass must be > 0, got -0 (an immovable body has m = inf)");
+      "minus_zero_m", [&](BodyRecord<T>& b) { b.m = -T(0); }, "m",
+      "mass must be > 0, got -0 (an immovable body has m = inf)");
   add(
       "negative_m", [&](BodyRecord<T>& b) { b.m = T(-1); }, "m", "mass must be > 0, got -1");
   add(
       "minus_inf_m", [&](BodyRecord<T>& b) { b.m = -inf; }, "m", "mass must be > 0, got -inf");
   // The moments likewise.
   add(
-      "zero_Ix", [&](BodyRecord<T>& b) { b.I[0] = T(0); }, "Ix", "moment of inertia must be > 0, got 0 (a locked axis has moment inf)");
+      "zero_Ix", [&](BodyRecord<T>& b) { b.I[0] = T(0); }, "Ix",
+      "moment of inertia must be > 0, got 0 (a locked axis has moment inf)");
   add(
       "negative_Iz", [&](BodyRecord<T>& b) { b.I[2] = T(-0.5); }, "Iz", "moment of inertia must be > 0, got -0.5");
   add(
