@@ -467,7 +467,7 @@ TEST(Passes, ZeroIsRefused) {
   EXPECT_THROW(Solver{o}, std::invalid_argument);
 }
 
-TEST(ColourSolve, ASolverRefusesASchedulOfTheOtherOrder) {
+TEST(ColourSolve, ASolverRefusesAScheduleOfTheOtherOrder) {
   Scene<double> scene = make_scene<double>(Kind::pile, 1000, false);
   const ContactView<double> c = scene.contacts.view();
   ImpulseBuffer<double> j(c.count);
