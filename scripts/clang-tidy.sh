@@ -114,8 +114,8 @@ for entry in json.load(open(db_path)):
     if rel not in sources and not rel.startswith(".."):
         sources.append(rel)
 known = set(sources)
-# Who includes whom, among the project's files: an #include "DIR/NAME.hpp" or
-# <collide/NAME.hpp> names the file of the tree whose path ends with it.
+# Who includes whom, among the project's files: the path an #include gives,
+# in quotes or angle brackets, names the tracked file whose path ends with it.
 tracked = subprocess.run(["git", "-C", root, "ls-files", "*.cpp", "*.hpp"], capture_output=True, text=True,
                          check=True).stdout.split()
 by_name = collections.defaultdict(list)
