@@ -130,18 +130,19 @@ double layout_solve(benchmark::State& state, Prepared<T>& p, const collide::Solv
       state, p, [&] { stats = solver.solve(view, contacts, impulses, p.schedule); }, [&] { pack_as(bodies, view); });
 }
 
-/// The packed twin's passes over records packed from the scene.
+/// The packed twin's passes over records packed from the scene, walked in
+/// `schedule` (the scene's own, or one of another order).
 template <class T, class Record>
-double packed_twin_solves(benchmark::State& state, Prepared<T>& p, int threads) {
+double packed_twin_solves(benchmark::State& state, Prepared<T>& p, int threads, const collide::Schedule& schedule) {
   oneapi::tbb::task_arena arena(threads);
   arena.initialize();
   collide::PackedBuffer<Record> records(p.bodies().count);
   pack_as(p.bodies(), collide::packed_view(records));
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
-  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, p.schedule);  // sizes its buffers
+  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule);  // sizes its buffers
   return timed_solves(state, p,
-                      [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, p.schedule); });
+                      [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule); });
 }
 
 }  // namespace
@@ -240,8 +241,8 @@ void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model 
 template <class T>
 void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model model, int threads) {
   Prepared<T>& p = prepared_scene<T>(kind, n, model, false);
-  const double seconds =
-      with_record<T>(model, [&](auto record) { return packed_twin_solves<T, decltype(record)>(state, p, threads); });
+  const double seconds = with_record<T>(
+      model, [&](auto record) { return packed_twin_solves<T, decltype(record)>(state, p, threads, p.schedule); });
   set_counters(state, solve_columns(n, collide::bytes_per_collision(model, sizeof(T), false), seconds, threads));
   state.SetLabel("memory only, packed");
 }
@@ -311,15 +312,7 @@ void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::
   Prepared<T>& p = prepared_scene<T>(kind, n);
   collide::Schedule schedule(order);
   schedule.build(p.contacts(), p.bodies(), threads);
-  oneapi::tbb::task_arena arena(threads);
-  arena.initialize();
-  collide::PackedBuffer<collide::PackedRigid<T>> records(p.bodies().count);
-  pack_as(p.bodies(), collide::packed_view(records));
-  const collide::ContactView<T> contacts = p.contacts();
-  const collide::ImpulseView<T> impulses = p.impulses.view();
-  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule);  // sizes its buffers
-  const double seconds = timed_solves(
-      state, p, [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule); });
+  const double seconds = packed_twin_solves<T, collide::PackedRigid<T>>(state, p, threads, schedule);
   Columns columns = solve_columns(n, bytes_per_collision<T>(p.friction), seconds, threads);
   columns.batches = static_cast<double>(schedule.batch_count());
   set_counters(state, columns);
