@@ -457,8 +457,9 @@ ImpulseBuffer<T> load_impulses(const std::string& path, SceneFormat format) {
     std::copy(column, column + j.count, into[k]);
   }
   // An impulse beyond T's range, as a scene value would be: refused at its row.
-  if (range)
+  if (range) {
     throw SceneError(archive.file_name(), 0, range->row, std::string(range->defect.column), range->defect.reason);
+  }
   return out;
 }
 
