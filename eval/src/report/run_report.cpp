@@ -329,7 +329,6 @@ class Runner {
     }
     ImpulseBuffer<T> impulses(scene.contacts.size());
     SavedVelocities<T> saved;
-    const double eps = std::numeric_limits<T>::epsilon();
 
     for (const Model model : kModels) {
       if (kind == SceneKind::file) {
@@ -365,22 +364,7 @@ class Runner {
                                   precision_name<T>(), friction, threads, n, sample.contacts.size());
           row.simd = path == Path::simd;
           progress_->show(what + ": " + row.variant + " " + row.model + ", " + std::to_string(threads) + " thread(s)");
-          const BodyView<T> bodies = scene.bodies.view();
-          const ContactView<T> contacts = scene.contacts.view();
-          SolveStats stats;
-          std::vector<double> seconds = time_runs(
-              config_.runs, [&] { saved.restore(bodies); },
-              [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
-          row.lanes = stats.lanes;
-          row.isa = to_string(stats.isa);
-          row.layout = to_string(stats.layout);
-          finish_speed(row, std::move(seconds), sizeof(T), model);
-
-          // The error sample, solved by the same solver.
-          BodyBuffer<T> after = sample.bodies;
-          ImpulseBuffer<T> j(sample.contacts.size());
-          s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
-          fill_error<T>(row, std::as_const(j).view(), std::as_const(after).view(), reference, eps);
+          measure_solver(row, s, model, scene, sample, saved, schedule, sample_schedule, impulses, reference);
           add(std::move(row));
         }
       }
@@ -406,23 +390,33 @@ class Runner {
       row.simd = true;
       row.order = "colour";
       row.note = "colour order";
-      const BodyView<T> bodies = scene.bodies.view();
-      const ContactView<T> contacts = scene.contacts.view();
-      SolveStats stats;
-      std::vector<double> seconds = time_runs(
-          config_.runs, [&] { saved.restore(bodies); },
-          [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
-      row.lanes = stats.lanes;
-      row.isa = to_string(stats.isa);
-      row.layout = to_string(stats.layout);
-      finish_speed(row, std::move(seconds), sizeof(T), model);
-      BodyBuffer<T> after = sample.bodies;
-      ImpulseBuffer<T> j(sample.contacts.size());
-      s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
-      fill_error<T>(row, std::as_const(j).view(), std::as_const(after).view(), reference,
-                    std::numeric_limits<T>::epsilon());
+      measure_solver(row, s, model, scene, sample, saved, schedule, sample_schedule, impulses, reference);
       add(std::move(row));
     }
+  }
+
+  /// A kernel row's figures: `s` timed on the scene (its velocities restored
+  /// before each run), then its error on the sample, solved by the same
+  /// solver, against `reference`.
+  template <class T>
+  void measure_solver(ReportRow& row, const Solver& s, Model model, Scene<T>& scene, const Scene<T>& sample,
+                      SavedVelocities<T>& saved, const Schedule& schedule, const Schedule& sample_schedule,
+                      ImpulseBuffer<T>& impulses, const ReferenceResult& reference) {
+    const BodyView<T> bodies = scene.bodies.view();
+    const ContactView<T> contacts = scene.contacts.view();
+    SolveStats stats;
+    std::vector<double> seconds = time_runs(
+        config_.runs, [&] { saved.restore(bodies); },
+        [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
+    row.lanes = stats.lanes;
+    row.isa = to_string(stats.isa);
+    row.layout = to_string(stats.layout);
+    finish_speed(row, std::move(seconds), sizeof(T), model);
+    BodyBuffer<T> after = sample.bodies;
+    ImpulseBuffer<T> j(sample.contacts.size());
+    s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
+    fill_error<T>(row, std::as_const(j).view(), std::as_const(after).view(), reference,
+                  std::numeric_limits<T>::epsilon());
   }
   double triad_bw(int threads) const {
     const auto it = triad_.find(threads);
