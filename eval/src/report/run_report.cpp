@@ -368,9 +368,10 @@ class Runner {
           add(std::move(row));
         }
       }
-      if (colour_rows)
+      if (colour_rows) {
         colour_order_rows(kind, friction, model, scene, sample, saved, colour_schedule, colour_sample_schedule,
                           impulses);
+      }
     }
   }
 
