@@ -622,13 +622,33 @@ COLLIDE_LANE_INLINE Vec3<V> summed_impulse(const Vec3<V>& before, const Vec3<V>&
   return {canonical_nan(before.x + j.x), canonical_nan(before.y + j.y), canonical_nan(before.z + j.z)};
 }
 
+/// evaluate_law_accurately, not inlined, for double: its double-double lanes
+/// make that body several times the fast mode's, and inlined into every
+/// caller (each model with and without friction, on each layout and body
+/// stream) it was half of each kernel object's compile time. Each caller
+/// calls the one copy of its model and friction instead; against the
+/// hundreds of double-double operations of a group, the call and the lanes
+/// passed through memory cost a few percent. The float kernel's wider lanes
+/// are plain double, cheap enough that the call would cost it more than
+/// its share of the compile time
+/// (docs/decisions/0032-the-double-accurate-law-out-of-line.md).
+template <class M, class V, bool kFriction>
+__attribute__((noinline)) ContactResult<V> evaluate_law_accurately_out_of_line(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                                               const ContactLanes<V>& contact) {
+  return evaluate_law_accurately<M, V, kFriction>(a, b, contact);
+}
+
 /// The law for W contacts in the mode `Mode` (FastMode or AccurateMode).
 template <class M, class V, bool kFriction, class Mode = FastMode>
 COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                       const ContactLanes<V>& contact) {
   ContactResult<V> r;
   if constexpr (std::is_same_v<Mode, AccurateMode>) {
-    r = evaluate_law_accurately<M, V, kFriction>(a, b, contact);
+    if constexpr (std::is_same_v<typename V::value_type, double>) {
+      r = evaluate_law_accurately_out_of_line<M, V, kFriction>(a, b, contact);
+    } else {
+      r = evaluate_law_accurately<M, V, kFriction>(a, b, contact);
+    }
   } else {
     r = evaluate_law<M, V, kFriction, FastMode>(a, b, contact);
   }
