@@ -147,89 +147,107 @@ COLLIDE_LANE_INLINE void gather_bodies(const View& bodies, const BodyIndex* ia, 
   }
 }
 
-/// Resolves one group of V::size() contacts; with `accumulate`, adds J to
-/// the impulses there (a later pass).
-template <class M, class V, bool kFriction, class Mode, class T, class View>
-COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                                     const ContactGroup& g, bool accumulate) {
+/// The bodies of a group's contacts: their indices, and how they lie in the
+/// SoA arrays (BodyStreams).
+template <std::size_t W>
+struct GroupBodies {
+  BodyIndex a[W];
+  BodyIndex b[W];
+  BodyStreams streams = BodyStreams::gathered;
+};
+
+template <class V, class T, class View>
+COLLIDE_LANE_INLINE GroupBodies<V::size()> group_bodies([[maybe_unused]] const View& bodies, const ContactView<T>& contacts,
+                                                        const ContactGroup& g) {
   constexpr std::size_t W = V::size();
-  BodyIndex ia[W];
-  BodyIndex ib[W];
+  GroupBodies<W> at;
   for (std::size_t l = 0; l < W; ++l) {
     const std::uint32_t k = g.contiguous ? g.first + static_cast<std::uint32_t>(l) : g.index[l];
-    ia[l] = contacts.a[k];
-    ib[l] = contacts.b[k];
-    assert(ia[l] < bodies.count && ib[l] < bodies.count && ia[l] != ib[l]);
+    at.a[l] = contacts.a[k];
+    at.b[l] = contacts.b[k];
+    assert(at.a[l] < bodies.count && at.b[l] < bodies.count && at.a[l] != at.b[l]);
   }
   // Only the SIMD path looks for streams; the scalar path (W = 1) would gain
   // nothing. The arithmetic is the same either way. The packed layout has
   // no such shortcut (its records are already contiguous per body).
-  BodyStreams streams = BodyStreams::gathered;
-  if constexpr (kSoaLayout<View>) {
-    if constexpr (W > 1) streams = body_streams<W>(ia, ib);
-  }
-  BodyLanes<M, V> a;
-  BodyLanes<M, V> b;
-  if constexpr (kSoaLayout<View>) {
-    if (streams == BodyStreams::paired) {
-      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-        load_deinterleaved(field + ia[0], la, lb);
-      });
-    } else if (streams == BodyStreams::runs) {
-      read_bodies<M, V>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-        la = load<V>(field + ia[0]);
-        lb = load<V>(field + ib[0]);
-      });
+  if constexpr (kSoaLayout<View> && W > 1) at.streams = body_streams<W>(at.a, at.b);
+  return at;
+}
+
+/// The group's bodies into lanes: every field the law reads, or with
+/// kOnlyVelocities the velocities alone (the velocity step, whose geometry
+/// is formed); a packed record's rows come whole either way.
+template <class M, class V, class T, bool kOnlyVelocities = false, class View>
+COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
+                                           BodyLanes<M, V>& b) {
+  const auto fields = [&](auto&& f) COLLIDE_LANE_LAMBDA {
+    if constexpr (kOnlyVelocities) {
+      velocity_fields<M>(bodies, a, b, f);
+    } else {
+      read_bodies<M, V>(bodies, a, b, f);
     }
-  }
-  if (streams == BodyStreams::gathered) gather_bodies<M, V, T>(bodies, ia, ib, a, b);
-
-  ContactLanes<V> c;
-  if constexpr (kRotates<M>) {
-    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
-  }
-  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
-  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
-  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
-
-  const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
-
-  // An immovable body is never written, not even with its own value: another
-  // thread may be reading it (the ground is in many contacts of a batch).
-  const auto movable_a = a.inv_mass != V(0);
-  const auto movable_b = b.inv_mass != V(0);
-  bool written = false;
+  };
   if constexpr (kSoaLayout<View>) {
-    // Whole vectors only when every body is movable: a's and b's bodies are
-    // then all distinct, and no immovable one is written.
-    if (streams != BodyStreams::gathered && stdx::all_of(movable_a && movable_b)) {
-      if (streams == BodyStreams::paired) {
-        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-          store_interleaved(la, lb, field + ia[0]);
-        });
-      } else {
-        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-          store(la, field + ia[0]);
-          store(lb, field + ib[0]);
-        });
-      }
-      written = true;
-    }
-  }
-  if constexpr (kSoaLayout<View>) {
-    if (!written) {
-      write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
-        scatter(la, field, ia, movable_a);
-        scatter(lb, field, ib, movable_b);
+    if (at.streams == BodyStreams::paired) {
+      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + at.a[0], la, lb); });
+    } else if (at.streams == BodyStreams::runs) {
+      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        la = load<V>(field + at.a[0]);
+        lb = load<V>(field + at.b[0]);
+      });
+    } else {
+      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+        la = gather<V>(field, at.a);
+        lb = gather<V>(field, at.b);
       });
     }
   } else {
+    read_records<M, V>(bodies, at.a, a);
+    read_records<M, V>(bodies, at.b, b);
+  }
+}
+
+/// The velocities the law left in the lanes, back to the group's bodies.
+/// An immovable body is never written, not even with its own value: another
+/// thread may be reading it (the ground is in many contacts of a batch).
+template <class M, class V, class T, class View>
+COLLIDE_LANE_INLINE void store_group_bodies(const View& bodies, const GroupBodies<V::size()>& at,
+                                            const BodyLanes<M, V>& a, const BodyLanes<M, V>& b) {
+  const auto movable_a = a.inv_mass != V(0);
+  const auto movable_b = b.inv_mass != V(0);
+  if constexpr (kSoaLayout<View>) {
+    // Whole vectors only when every body is movable: a's and b's bodies are
+    // then all distinct, and no immovable one is written.
+    if (at.streams != BodyStreams::gathered && stdx::all_of(movable_a && movable_b)) {
+      if (at.streams == BodyStreams::paired) {
+        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+          store_interleaved(la, lb, field + at.a[0]);
+        });
+      } else {
+        write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+          store(la, field + at.a[0]);
+          store(lb, field + at.b[0]);
+        });
+      }
+      return;
+    }
+    write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
+      scatter(la, field, at.a, movable_a);
+      scatter(lb, field, at.b, movable_b);
+    });
+  } else {
     // a's records first, then b's: within a group no movable body repeats,
     // so the order of the stores cannot matter.
-    write_records<M, V>(bodies, ia, a, movable_a);
-    write_records<M, V>(bodies, ib, b, movable_b);
+    write_records<M, V>(bodies, at.a, a, movable_a);
+    write_records<M, V>(bodies, at.b, b, movable_b);
   }
-  Vec3<V> j = r.j;
+}
+
+/// The group's J to the impulse arrays, or with `accumulate` added to what
+/// they hold (a later pass).
+template <class V, class T>
+COLLIDE_LANE_INLINE void store_group_impulses(const ImpulseView<T>& impulses, const ContactGroup& g, Vec3<V> j,
+                                              bool accumulate) {
   if (g.contiguous) {
     if (accumulate) {
       j = summed_impulse(
@@ -250,6 +268,64 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
     scatter(j.y, impulses.j.y, g.index, all);
     scatter(j.z, impulses.j.z, g.index, all);
   }
+}
+
+/// Resolves one group of V::size() contacts; with `accumulate`, adds J to
+/// the impulses there (a later pass).
+template <class M, class V, bool kFriction, class Mode, class T, class View>
+COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                                     const ContactGroup& g, bool accumulate) {
+  const GroupBodies<V::size()> at = group_bodies<V>(bodies, contacts, g);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  load_group_bodies<M, V, T>(bodies, at, a, b);
+
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
+
+  const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
+  store_group_bodies<M, V, T>(bodies, at, a, b);
+  store_group_impulses<V>(impulses, g, r.j, accumulate);
+}
+
+template <class V>
+COLLIDE_LANE_INLINE Vec3<V> load3(typename V::value_type* const (&from)[3], std::size_t at) {
+  return {load<V>(from[0] + at), load<V>(from[1] + at), load<V>(from[2] + at)};
+}
+
+/// The velocity step of one group of V::size() consecutive contacts at
+/// `first`, whose geometry is formed (KernelJob::stepped): the second half
+/// of the law on the first half's stored values, so the bits are those of
+/// solve_group (fast mode, frictionless).
+template <class M, class V, class T, class View>
+COLLIDE_LANE_INLINE void step_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                                    const GeometryView<T>& geometry, std::uint32_t first, bool accumulate) {
+  const ContactGroup g{true, first, nullptr};
+  const GroupBodies<V::size()> at = group_bodies<V>(bodies, contacts, g);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  load_group_bodies<M, V, T, true>(bodies, at, a, b);
+  a.inv_mass = load<V>(geometry.inv_mass_a + first);
+  b.inv_mass = load<V>(geometry.inv_mass_b + first);
+  ContactGeometry<V> geo{};
+  if constexpr (kRotates<M>) {
+    geo.ra = load3<V>(geometry.ra, first);
+    geo.rb = load3<V>(geometry.rb, first);
+    geo.arm_a = {load3<V>(geometry.response_a, first), load<V>(geometry.k_a + first)};
+    geo.arm_b = {load3<V>(geometry.response_b, first), load<V>(geometry.k_b + first)};
+  }
+  ContactLanes<V> c;
+  c.n = {load<V>(contacts.n.x + first), load<V>(contacts.n.y + first), load<V>(contacts.n.z + first)};
+  c.e = contacts.e ? load<V>(contacts.e + first) : V(contacts.uniform_e);
+  ContactResult<V> r = velocity_step<M, V, false, FastMode>(a, b, c, geo);
+  canonical_outputs(a, b, r.j);  // as resolve_contacts
+  store_group_bodies<M, V, T>(bodies, at, a, b);
+  store_group_impulses<V>(impulses, g, r.j, accumulate);
 }
 
 /// Contacts [begin, end) of the schedule's order, all inside one batch, in
@@ -364,22 +440,36 @@ std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::s
   });
 }
 
-/// ... and its accuracy mode.
+/// The velocity step of the job's contacts [begin, end), consecutive, whose
+/// geometry is formed (KernelJob::stepped), in groups of W.
+template <class V, class T>
+std::size_t step_job_groups(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
+  // Positions are contact indices: stepped jobs are prepared (identity order).
+  assert(job.stepped && !job.accurate && !job.friction && (begin == end || job.order[begin] == begin));
+  constexpr std::size_t W = V::size();
+  return with_view(job, [&](const auto& view, auto model) {
+    std::size_t i = begin;
+    for (; i + W <= end; i += W) {
+      step_group<decltype(model), V, T>(view, job.contacts, job.impulses, job.geometry, static_cast<std::uint32_t>(i),
+                                        job.accumulate);
+    }
+    return i;
+  });
+}
+
+/// ... and its accuracy mode (or only the velocity step).
 template <class V, class T>
 std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
+  if (job.stepped) return step_job_groups<V, T>(job, begin, end);
   return job.accurate ? solve_job_groups_in<V, T, AccurateMode>(job, contiguous, begin, end)
                       : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
 }
 
 template <class V>
-COLLIDE_LANE_INLINE void store3(const Vec3<V>& v, typename V::value_type (*to)[kRunPiece], std::size_t at) {
+COLLIDE_LANE_INLINE void store3(const Vec3<V>& v, typename V::value_type* const (&to)[3], std::size_t at) {
   store(v.x, to[0] + at);
   store(v.y, to[1] + at);
   store(v.z, to[2] + at);
-}
-template <class S>
-COLLIDE_LANE_INLINE Vec3<S> load3(const typename S::value_type (*from)[kRunPiece], std::size_t at) {
-  return {S(from[0][at]), S(from[1][at]), S(from[2][at])};
 }
 
 /// First pass: the geometry of the W contacts order[at], ... of a piece, in
@@ -390,7 +480,7 @@ COLLIDE_LANE_INLINE Vec3<S> load3(const typename S::value_type (*from)[kRunPiece
 /// before have left them.
 template <class M, class V, class T, class View>
 COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* index,
-                                      RunPiece<T>& piece, std::size_t at) {
+                                      const GeometryView<T>& into, std::size_t at) {
   constexpr std::size_t W = V::size();
   BodyIndex ia[W];
   BodyIndex ib[W];
@@ -408,15 +498,15 @@ COLLIDE_LANE_INLINE void run_geometry(const View& bodies, const ContactView<T>& 
   }
   c.n = {gather<V>(contacts.n.x, index), gather<V>(contacts.n.y, index), gather<V>(contacts.n.z, index)};
   const ContactGeometry<V> g = contact_geometry(a, b, c);
-  store(a.inv_mass, piece.inv_mass_a + at);
-  store(b.inv_mass, piece.inv_mass_b + at);
+  store(a.inv_mass, into.inv_mass_a + at);
+  store(b.inv_mass, into.inv_mass_b + at);
   if constexpr (kRotates<M>) {
-    store3(g.ra, piece.ra, at);
-    store3(g.rb, piece.rb, at);
-    store3(g.arm_a.response, piece.response_a, at);
-    store3(g.arm_b.response, piece.response_b, at);
-    store(g.arm_a.k, piece.k_a + at);
-    store(g.arm_b.k, piece.k_b + at);
+    store3(g.ra, into.ra, at);
+    store3(g.rb, into.rb, at);
+    store3(g.arm_a.response, into.response_a, at);
+    store3(g.arm_b.response, into.response_b, at);
+    store(g.arm_a.k, into.k_a + at);
+    store(g.arm_b.k, into.k_b + at);
   }
 }
 
@@ -451,31 +541,31 @@ COLLIDE_LANE_INLINE void write_velocities(const View& view, BodyIndex i, const B
   if constexpr (kRotates<M>) *w[0] = body.w.x[0], *w[1] = body.w.y[0], *w[2] = body.w.z[0];
 }
 
-/// The geometry of the contacts order[first, first + count) of a run (count
-/// <= kRunPiece) into `piece`: what does not depend on the velocities (the
-/// offsets, the lever arms and their K terms: most of the arithmetic, and all
-/// of the wide lever arms' work), formed in lanes of V, W contacts at a time,
-/// the rest one by one. No contact of the run changes a position or an
-/// orientation, so it may be formed before the contacts ahead are walked.
+/// The geometry of the contacts order[0, count) into `into` (a piece of a
+/// run, or the prepared contacts of several passes): what does not depend
+/// on the velocities (the offsets, the lever arms and their K terms: most of
+/// the arithmetic, and all of the wide lever arms' work), formed in lanes of
+/// V, W contacts at a time, the rest one by one. No contact of a solve
+/// changes a position or an orientation, so it may be formed before any
+/// contact is stepped.
 template <class M, class V, class T, class View>
 void piece_geometry(const View& bodies, const ContactView<T>& contacts, const std::uint32_t* order, std::size_t count,
-                    RunPiece<T>& piece) {
+                    const GeometryView<T>& into) {
   using S = ScalarLanes<T>;
   constexpr std::size_t W = V::size();
-  assert(count <= kRunPiece);
   std::size_t at = 0;
-  for (; at + W <= count; at += W) run_geometry<M, V, T>(bodies, contacts, order + at, piece, at);
-  for (; at < count; ++at) run_geometry<M, S, T>(bodies, contacts, order + at, piece, at);
+  for (; at + W <= count; at += W) run_geometry<M, V, T>(bodies, contacts, order + at, into, at);
+  for (; at < count; ++at) run_geometry<M, S, T>(bodies, contacts, order + at, into, at);
 }
 
-/// The walk of the contacts order[0, count) of a piece, in order, in one
-/// lane: each reads the velocities the contacts before it left and takes the
-/// law's velocity step (velocity_step) with the geometry piece_geometry
-/// formed: the two halves evaluate_law composes, so the bits are those of
-/// the one-lane kernel.
+/// The walk of the contacts order[0, count), in order, in one lane: each
+/// reads the velocities the contacts before it left and takes the law's
+/// velocity step (velocity_step) with the geometry piece_geometry formed:
+/// the two halves evaluate_law composes, so the bits are those of the
+/// one-lane kernel.
 template <class M, class T, class View>
 void piece_walk(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses, bool accumulate,
-                const std::uint32_t* order, std::size_t count, const RunPiece<T>& piece) {
+                const std::uint32_t* order, std::size_t count, const GeometryView<T>& geometry) {
   using S = ScalarLanes<T>;
   for (std::size_t j = 0; j < count; ++j) {
     const std::uint32_t k = order[j];
@@ -483,8 +573,8 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
     const BodyIndex ib = contacts.b[k];
     BodyLanes<M, S> a;
     BodyLanes<M, S> b;
-    a.inv_mass = S(piece.inv_mass_a[j]);
-    b.inv_mass = S(piece.inv_mass_b[j]);
+    a.inv_mass = S(geometry.inv_mass_a[j]);
+    b.inv_mass = S(geometry.inv_mass_b[j]);
     read_velocities<M, S>(bodies, ia, a);
     read_velocities<M, S>(bodies, ib, b);
     ContactLanes<S> c;
@@ -492,17 +582,17 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
     c.e = S(contacts.e != nullptr ? contacts.e[k] : contacts.uniform_e);
     ContactGeometry<S> g{};
     if constexpr (kRotates<M>) {
-      g.ra = load3<S>(piece.ra, j);
-      g.rb = load3<S>(piece.rb, j);
-      g.arm_a = {load3<S>(piece.response_a, j), S(piece.k_a[j])};
-      g.arm_b = {load3<S>(piece.response_b, j), S(piece.k_b[j])};
+      g.ra = load3<S>(geometry.ra, j);
+      g.rb = load3<S>(geometry.rb, j);
+      g.arm_a = {load3<S>(geometry.response_a, j), S(geometry.k_a[j])};
+      g.arm_b = {load3<S>(geometry.response_b, j), S(geometry.k_b[j])};
     }
     ContactResult<S> r = velocity_step<M, S, false, FastMode>(a, b, c, g);
     canonical_outputs(a, b, r.j);  // as resolve_contacts
     Vec3<S> jv = r.j;
     if (accumulate) jv = summed_impulse(Vec3<S>{S(impulses.j.x[k]), S(impulses.j.y[k]), S(impulses.j.z[k])}, jv);
-    if (piece.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
-    if (piece.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
+    if (geometry.inv_mass_a[j] != T(0)) write_velocities<M, S>(bodies, ia, a);
+    if (geometry.inv_mass_b[j] != T(0)) write_velocities<M, S>(bodies, ib, b);
     impulses.j.x[k] = jv.x[0];
     impulses.j.y[k] = jv.y[0];
     impulses.j.z[k] = jv.z[0];
@@ -518,29 +608,31 @@ void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const 
   RunPiece<T> piece;
   for (std::size_t first = begin; first < end; first += kRunPiece) {
     const std::size_t count = std::min(kRunPiece, end - first);
-    piece_geometry<M, V, T>(bodies, contacts, order + first, count, piece);
-    piece_walk<M, T>(bodies, contacts, impulses, accumulate, order + first, count, piece);
+    piece_geometry<M, V, T>(bodies, contacts, order + first, count, piece.view());
+    piece_walk<M, T>(bodies, contacts, impulses, accumulate, order + first, count, piece.view());
   }
 }
 
 /// RunGeometryKernel and RunWalkKernel of kernel_table.hpp.
 template <class T>
-void run_piece_geometry(const KernelJob<T>& job, std::size_t first, std::size_t count, RunPiece<T>& piece) {
+void run_piece_geometry(const KernelJob<T>& job, std::size_t first, std::size_t count, const GeometryView<T>& into) {
   assert(!job.accurate && !job.friction);
   with_view(job, [&](const auto& view, auto model) {
-    piece_geometry<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.order + first, count, piece);
+    piece_geometry<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.order + first, count, into);
   });
 }
 template <class T>
-void run_piece_walk(const KernelJob<T>& job, std::size_t first, std::size_t count, const RunPiece<T>& piece) {
+void run_piece_walk(const KernelJob<T>& job, std::size_t first, std::size_t count, const GeometryView<T>& geometry) {
   assert(!job.accurate && !job.friction);
   with_view(job, [&](const auto& view, auto model) {
-    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + first, count, piece);
+    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + first, count,
+                                   geometry);
   });
 }
 
-/// A run of the job (solve_run_pieces); the accurate mode and friction take
-/// the one-lane kernel, contact by contact.
+/// A run of the job (solve_run_pieces), or its walk alone when its geometry
+/// is formed (KernelJob::stepped); the accurate mode and friction take the
+/// one-lane kernel, contact by contact.
 template <class T>
 void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
   if (job.accurate || job.friction) {
@@ -548,6 +640,11 @@ void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
     return;
   }
   with_view(job, [&](const auto& view, auto model) {
+    if (job.stepped) {
+      piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + begin, end - begin,
+                                     job.geometry.from(begin));
+      return;
+    }
     solve_run_pieces<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.impulses, job.accumulate, job.order,
                                                        begin, end);
   });

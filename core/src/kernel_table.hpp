@@ -31,6 +31,40 @@
 
 namespace collide::detail {
 
+/// The velocity-free half of the law (contact_kernel.hpp, ContactGeometry)
+/// and the inverse masses of a span of contacts, one array per value, by
+/// position in the span: a piece of a run (RunPiece), or every prepared
+/// contact of a colour-order solve with several passes, formed once and
+/// read by every pass (prepared_contacts.hpp). The geometry pass stores
+/// lanes, the velocity step reads lanes or one value.
+template <class T>
+struct GeometryView {
+  T* ra[3] = {};          ///< [m] c - pa (sphere, rigid)
+  T* rb[3] = {};          ///< [m] c - pb
+  T* response_a[3] = {};  ///< [1/(kg m)] a's angular response per unit impulse along n
+  T* response_b[3] = {};  ///< [1/(kg m)]
+  T* k_a = nullptr;       ///< [1/kg] a's rotational share of K(n)
+  T* k_b = nullptr;       ///< [1/kg]
+  T* inv_mass_a = nullptr;  ///< [1/kg] as stored: 0 for an immovable body
+  T* inv_mass_b = nullptr;  ///< [1/kg]
+
+  /// The same arrays from position `at` on.
+  [[nodiscard]] GeometryView from(std::size_t at) const {
+    GeometryView g = *this;
+    for (std::size_t i = 0; i < 3; ++i) {
+      g.ra[i] = ra[i] + at;
+      g.rb[i] = rb[i] + at;
+      g.response_a[i] = response_a[i] + at;
+      g.response_b[i] = response_b[i] + at;
+    }
+    g.k_a = k_a + at;
+    g.k_b = k_b + at;
+    g.inv_mass_a = inv_mass_a + at;
+    g.inv_mass_b = inv_mass_b + at;
+    return g;
+  }
+};
+
 /// Everything a kernel needs besides the range: the bodies in the view of
 /// `model` and layout (only that member is set), the contacts, where J goes,
 /// and the schedule's order.
@@ -52,6 +86,11 @@ struct KernelJob {
   ContactView<T> contacts;
   ImpulseView<T> impulses;
   const std::uint32_t* order = nullptr;
+  /// Set when `geometry` holds the velocity-free half of the law of every
+  /// contact, by position in `order` (fast mode, frictionless): the kernels
+  /// take the velocity step alone, on the geometry stored there.
+  bool stepped = false;
+  GeometryView<T> geometry;
 };
 
 /// Resolves order[begin, end) (all inside one batch; `contiguous` when the
@@ -69,9 +108,7 @@ using RunKernel = void (*)(const KernelJob<T>& job, std::size_t begin, std::size
 /// forms it and the walk that reads it.
 inline constexpr std::size_t kRunPiece = 128;
 
-/// The geometry of a piece of a run (the offsets, lever arms and K terms of
-/// contact_kernel.hpp's ContactGeometry) and the inverse masses, one array
-/// per value: the geometry pass stores lanes, the walk reads one value.
+/// The geometry of a piece of a run, in arrays of its own.
 template <class T>
 struct RunPiece {
   alignas(64) T ra[3][kRunPiece];
@@ -82,18 +119,28 @@ struct RunPiece {
   alignas(64) T k_b[kRunPiece];
   alignas(64) T inv_mass_a[kRunPiece];
   alignas(64) T inv_mass_b[kRunPiece];
+
+  [[nodiscard]] GeometryView<T> view() {
+    return {{ra[0], ra[1], ra[2]}, {rb[0], rb[1], rb[2]}, {response_a[0], response_a[1], response_a[2]},
+            {response_b[0], response_b[1], response_b[2]}, k_a, k_b, inv_mass_a, inv_mass_b};
+  }
 };
 
-/// The two halves of a run, for a driver that overlaps them on two threads
-/// (run_pipeline.hpp): the geometry of order[first, first + count) (count <=
-/// kRunPiece) into `piece`, which reads positions, orientations and inverse
-/// masses but no velocity (SoA layouts only: a packed record holds both);
-/// and the walk of those contacts over their piece, in order, reading and
-/// writing velocities. Fast mode, frictionless, as RunKernel.
+/// The two halves of the law over a span of contacts, the driver's to
+/// sequence: the geometry of order[first, first + count) into `into` (at
+/// positions 0 .. count), which reads positions, orientations and inverse
+/// masses but no velocity (for a packed record, whose rows hold both, the
+/// velocities are ignored); and the walk of those contacts over their
+/// geometry, in order, one contact after another, reading and writing
+/// velocities. Fast mode, frictionless. A run's pieces take turns on two
+/// threads (run_pipeline.hpp); a colour-order solve with several passes
+/// forms the geometry of every prepared contact once (solve.cpp).
 template <class T>
-using RunGeometryKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count, RunPiece<T>& piece);
+using RunGeometryKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                                   const GeometryView<T>& into);
 template <class T>
-using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count, const RunPiece<T>& piece);
+using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                               const GeometryView<T>& geometry);
 
 /// The SIMD kernels of one instruction set.
 struct KernelTable {

@@ -34,7 +34,9 @@ void gather(V* to, const V* from, const std::uint32_t* order, std::size_t begin,
 }  // namespace
 
 template <class T>
-void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& contacts, const std::uint32_t* order) {
+void PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form) {
+  const ContactView<T>& contacts = job.contacts;
+  const std::uint32_t* order = job.order;
   const std::size_t n = contacts.count;
   // The point only where the model reads it: a particle solve may have none.
   const bool point = contacts.c.x != nullptr && contacts.c.y != nullptr && contacts.c.z != nullptr;
@@ -67,6 +69,25 @@ void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& 
   view_ = v;
   impulses_.count = n;
   impulses_.j = {j_[0].data(), j_[1].data(), j_[2].data()};
+  KernelJob<T> on_prepared = job;
+  on_prepared.contacts = view_;
+  on_prepared.impulses = impulses_;
+  on_prepared.order = identity_.data();
+  geometry_view_ = {};
+  if (form != nullptr) {
+    for (ScratchVector<T>& values : geometry_) values.resize(n);
+    GeometryView<T>& g = geometry_view_;
+    for (std::size_t k = 0; k < 3; ++k) {
+      g.ra[k] = geometry_[k].data();
+      g.rb[k] = geometry_[3 + k].data();
+      g.response_a[k] = geometry_[6 + k].data();
+      g.response_b[k] = geometry_[9 + k].data();
+    }
+    g.k_a = geometry_[12].data();
+    g.k_b = geometry_[13].data();
+    g.inv_mass_a = geometry_[14].data();
+    g.inv_mass_b = geometry_[15].data();
+  }
 
   for_parts(arena, n, [&](std::size_t begin, std::size_t end) {
     gather(a_.data(), contacts.a, order, begin, end);
@@ -81,6 +102,9 @@ void PreparedContacts<T>::prepare(tbb::task_arena& arena, const ContactView<T>& 
     gather(n_[2].data(), contacts.n.z, order, begin, end);
     if (contacts.e != nullptr) gather(e_.data(), contacts.e, order, begin, end);
     if (contacts.mu != nullptr) gather(mu_.data(), contacts.mu, order, begin, end);
+    // Positions and orientations are the bodies' as the solve starts: no
+    // contact changes them, so the geometry formed now serves every pass.
+    if (form != nullptr) form(on_prepared, begin, end - begin, geometry_view_.from(begin));
   });
 }
 

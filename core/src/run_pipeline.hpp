@@ -100,7 +100,7 @@ class PipelinedRun {
         SpinWait wait;
         while (slots_[i % kRunSlots].holds.load(std::memory_order_acquire) != i + 1) wait.pause();
       }
-      walk_(job_, first_of(i), count_of(i), slots_[i % kRunSlots].piece);
+      walk_(job_, first_of(i), count_of(i), slots_[i % kRunSlots].piece.view());
       // Release: the walk's reads of the slot come before a helper refills it.
       walked_.store(i + 1, std::memory_order_release);
     }
@@ -133,7 +133,7 @@ class PipelinedRun {
   [[nodiscard]] std::size_t count_of(std::size_t i) const { return std::min(kRunPiece, end_ - first_of(i)); }
   void form(std::size_t i) {
     Slot& slot = slots_[i % kRunSlots];
-    geometry_(job_, first_of(i), count_of(i), slot.piece);
+    geometry_(job_, first_of(i), count_of(i), slot.piece.view());
     slot.holds.store(i + 1, std::memory_order_release);
   }
 

@@ -141,7 +141,7 @@ class Walk {
         kernel_(job, consecutive(k), begin, stop);
       } else if (!plan_.simd) {
         solve_range_scalar<T>(job, false, begin, stop);
-      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction &&
+      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction && !job.stepped &&
                  stop - begin >= kPipelinedRunPieces * kRunPiece) {
         run_pipelined(job, begin, stop);
       } else {

@@ -158,14 +158,21 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   plan.passes = static_cast<std::size_t>(options.passes);
   if (detail::prepares_contacts(schedule)) {
     // Copied in, walked every pass, J copied out: the copies cost two
-    // streaming passes, the gathers they spare one per colour.
+    // streaming passes, the gathers they spare one per colour. With several
+    // passes of the fast frictionless law, the velocity-free half is formed
+    // with the copy and every pass takes the velocity step alone.
     const std::lock_guard<std::mutex> lock(prepare_mutex);
     detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
-    prepared_contacts.prepare(*arena, job.contacts, schedule.order());
+    const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
+    prepared_contacts.prepare(
+        *arena, job,
+        stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
     detail::KernelJob<T> on_prepared = job;
     on_prepared.contacts = prepared_contacts.contacts();
     on_prepared.impulses = prepared_contacts.impulses();
     on_prepared.order = prepared_contacts.identity();
+    on_prepared.stepped = stepped;
+    on_prepared.geometry = prepared_contacts.geometry();
     plan.prepared = true;
     detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());

@@ -61,6 +61,10 @@ bool prepares_contacts(const Schedule& schedule) {
   return false;
 }
 
+bool steps_prepared_contacts(std::size_t passes, bool accurate, bool friction) {
+  return passes > 1 && !accurate && !friction;
+}
+
 std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b) {
   std::size_t n = 0;
   const std::uint32_t* order = schedule.order();

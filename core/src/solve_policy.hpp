@@ -48,6 +48,14 @@ std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, con
 /// batches, pairs', reads the caller's arrays as they are.)
 bool prepares_contacts(const Schedule& schedule);
 
+/// Whether a solve on prepared contacts forms the velocity-free half of the
+/// law once, with the copy, and takes the velocity step alone in every pass
+/// (prepared_contacts.hpp): with several passes, in the fast mode, without
+/// friction. (The Coulomb step's lever arms lie along the sliding
+/// direction, which the velocities decide; the accurate mode forms its
+/// geometry in wider lanes than it could store.)
+bool steps_prepared_contacts(std::size_t passes, bool accurate, bool friction);
+
 /// Whether SoA input of `bodies` bodies, `scattered` of whose contacts reach
 /// them at random, is packed (BodyLayout::automatic), or what `layout` forces.
 bool should_pack(BodyLayout layout, std::size_t scattered, std::size_t bodies);
