@@ -157,8 +157,8 @@ struct GroupBodies {
 };
 
 template <class V, class T, class View>
-COLLIDE_LANE_INLINE GroupBodies<V::size()> group_bodies([[maybe_unused]] const View& bodies, const ContactView<T>& contacts,
-                                                        const ContactGroup& g) {
+COLLIDE_LANE_INLINE GroupBodies<V::size()> group_bodies([[maybe_unused]] const View& bodies,
+                                                        const ContactView<T>& contacts, const ContactGroup& g) {
   constexpr std::size_t W = V::size();
   GroupBodies<W> at;
   for (std::size_t l = 0; l < W; ++l) {

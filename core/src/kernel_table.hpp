@@ -39,12 +39,12 @@ namespace collide::detail {
 /// lanes, the velocity step reads lanes or one value.
 template <class T>
 struct GeometryView {
-  T* ra[3] = {};          ///< [m] c - pa (sphere, rigid)
-  T* rb[3] = {};          ///< [m] c - pb
-  T* response_a[3] = {};  ///< [1/(kg m)] a's angular response per unit impulse along n
-  T* response_b[3] = {};  ///< [1/(kg m)]
-  T* k_a = nullptr;       ///< [1/kg] a's rotational share of K(n)
-  T* k_b = nullptr;       ///< [1/kg]
+  T* ra[3] = {};            ///< [m] c - pa (sphere, rigid)
+  T* rb[3] = {};            ///< [m] c - pb
+  T* response_a[3] = {};    ///< [1/(kg m)] a's angular response per unit impulse along n
+  T* response_b[3] = {};    ///< [1/(kg m)]
+  T* k_a = nullptr;         ///< [1/kg] a's rotational share of K(n)
+  T* k_b = nullptr;         ///< [1/kg]
   T* inv_mass_a = nullptr;  ///< [1/kg] as stored: 0 for an immovable body
   T* inv_mass_b = nullptr;  ///< [1/kg]
 
@@ -121,8 +121,14 @@ struct RunPiece {
   alignas(64) T inv_mass_b[kRunPiece];
 
   [[nodiscard]] GeometryView<T> view() {
-    return {{ra[0], ra[1], ra[2]}, {rb[0], rb[1], rb[2]}, {response_a[0], response_a[1], response_a[2]},
-            {response_b[0], response_b[1], response_b[2]}, k_a, k_b, inv_mass_a, inv_mass_b};
+    return {{ra[0], ra[1], ra[2]},
+            {rb[0], rb[1], rb[2]},
+            {response_a[0], response_a[1], response_a[2]},
+            {response_b[0], response_b[1], response_b[2]},
+            k_a,
+            k_b,
+            inv_mass_a,
+            inv_mass_b};
   }
 };
 

@@ -165,8 +165,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
     prepared_contacts.prepare(
-        *arena, job,
-        stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
+        *arena, job, stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
     detail::KernelJob<T> on_prepared = job;
     on_prepared.contacts = prepared_contacts.contacts();
     on_prepared.impulses = prepared_contacts.impulses();

@@ -321,8 +321,8 @@ void expect_sequential_law(const SolveCase& p, Model model, Accuracy accuracy) {
     for (const int threads : {1, 2, 3}) {
       for (const Path path : {Path::scalar, Path::simd}) {
         for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
-          SCOPED_TRACE(std::to_string(passes) + " passes, " + std::to_string(threads) + " threads, " +
-                       to_string(path) + ", " + to_string(layout));
+          SCOPED_TRACE(std::to_string(passes) + " passes, " + std::to_string(threads) + " threads, " + to_string(path) +
+                       ", " + to_string(layout));
           SolverOptions o = options_for(path, threads, 64);
           o.order = Order::colour;
           o.layout = layout;
@@ -493,9 +493,9 @@ TEST(ColourSolve, ASolverRefusesAScheduleOfTheOtherOrder) {
 TEST(ColourSolve, ImmovableBodiesAreNeverChanged) {
   // With friction and without: three frictionless passes take the velocity
   // step alone on the geometry the prepare formed.
-  for (const auto& [kind, friction] : {std::pair{Kind::debris, true}, std::pair{Kind::pile, true},
-                                       std::pair{Kind::shared, true}, std::pair{Kind::debris, false},
-                                       std::pair{Kind::pile, false}}) {
+  for (const auto& [kind, friction] :
+       {std::pair{Kind::debris, true}, std::pair{Kind::pile, true}, std::pair{Kind::shared, true},
+        std::pair{Kind::debris, false}, std::pair{Kind::pile, false}}) {
     SCOPED_TRACE(std::string(name(kind)) + (friction ? " friction" : ""));
     const Scene<float> scene = make_scene<float>(kind, 20000, friction);
     for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
