@@ -2,6 +2,7 @@
 #include "run_schedule.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdint>
 
@@ -16,12 +17,15 @@ namespace {
 /// threads costs about what the kernel spends on a few dozen contacts.
 constexpr std::size_t kMinItem = 64;
 
-/// Most items per thread a batch splits into. Threads take items in turn,
-/// so small items would have each thread leap from stretch to stretch of
-/// the arrays, and the hardware's stream prefetchers restart at every leap:
-/// a few long items per thread stream, and still even out a thread that
-/// runs late.
+/// Most items per thread a batch splits into. Small items would have each
+/// thread leap from stretch to stretch of the arrays, and the hardware's
+/// stream prefetchers restart at every leap: a few long items per thread
+/// stream, and still even out a thread that runs late.
 constexpr std::size_t kItemsPerThread = 4;
+
+/// Most items of one step, whatever the thread count (the claim stamps are a
+/// fixed array: a walk allocates nothing).
+constexpr std::size_t kMaxItems = 256;
 
 /// One step of the walk: batches [first_batch, end_batch) of pass `pass`,
 /// which are items [first_item, first_item + items) of the walk.
@@ -49,22 +53,19 @@ class Walk {
     later_.accumulate = true;
   }
 
-  /// What every thread of the walk does: claims items in order and runs
-  /// each once the steps before it are done; returns when all have finished.
-  void work() {
+  /// What every thread of the walk does, thread `worker` of the arena's:
+  /// step after step, once the steps before are done, claims items from its
+  /// home forward, then backward, and runs them; returns when all have
+  /// finished.
+  void work(int worker) {
     Step step;  // the empty step before the first
-    for (;;) {
-      const std::uint64_t item = claimed_.fetch_add(1, std::memory_order_relaxed);
-      while (item >= step.first_item + step.items) {
-        if (!next_step(step)) {
-          wait_for(step.first_item + step.items);
-          return;
-        }
-      }
+    while (next_step(step)) {
       wait_for(step.first_item);
-      run_item(step, static_cast<std::size_t>(item - step.first_item));
-      finished_.fetch_add(1, std::memory_order_acq_rel);
+      const std::size_t home = static_cast<std::size_t>(worker) * step.items / static_cast<std::size_t>(threads_);
+      for (std::size_t i = home; i < step.items && claim(step, i); ++i) run_claimed(step, i);
+      for (std::size_t i = home; i-- > 0 && claim(step, i);) run_claimed(step, i);
     }
+    wait_for(step.first_item + step.items);
   }
 
  private:
@@ -79,7 +80,24 @@ class Walk {
     if (threads_ == 1 || n < 2 * kMinItem) return 1;
     const auto threads = static_cast<std::size_t>(threads_);
     const std::size_t blocks = (n + plan_.block - 1) / plan_.block;
-    return std::max(std::min(blocks, kItemsPerThread * threads), std::min(threads, n / kMinItem));
+    return std::min(kMaxItems, std::max(std::min(blocks, kItemsPerThread * threads), std::min(threads, n / kMinItem)));
+  }
+
+  /// Takes item i of step s for this thread; false if another took it. A
+  /// stamp holds one more than the first item number of the step that last
+  /// took it, which only grows from step to step.
+  bool claim(const Step& s, std::size_t i) {
+    const std::uint64_t mine = s.first_item + 1;
+    std::uint64_t seen = stamps_[i].load(std::memory_order_relaxed);
+    while (seen < mine) {
+      if (stamps_[i].compare_exchange_weak(seen, mine, std::memory_order_relaxed)) return true;
+    }
+    return false;
+  }
+
+  void run_claimed(const Step& s, std::size_t i) {
+    run_item(s, i);
+    finished_.fetch_add(1, std::memory_order_acq_rel);
   }
 
   /// The step after `s`; false after the last.
@@ -183,7 +201,7 @@ class Walk {
   const RunWalkKernel<T> run_walk_;
   KernelJob<T> first_;  // the first pass: J written
   KernelJob<T> later_;  // the passes after: J added
-  std::atomic<std::uint64_t> claimed_{0};
+  std::array<std::atomic<std::uint64_t>, kMaxItems> stamps_{};
   std::atomic<std::uint64_t> finished_{0};
   std::atomic<PipelinedRun<T>*> run_{nullptr};
   std::atomic<int> helping_{0};
@@ -198,15 +216,15 @@ void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_are
     const int threads = std::max(1, arena.max_concurrency());
     Walk<T> walk(table, plan, threads, job, schedule);
     if (threads == 1) {
-      walk.work();
+      walk.work(0);
       return;
     }
     // The other threads are tasks of the arena: one that starts late finds
     // its items claimed, and one that never starts is run by wait() once
     // every item is done, and returns at once.
     tbb::task_group helpers;
-    for (int t = 1; t < threads; ++t) helpers.run([&walk] { walk.work(); });
-    walk.work();
+    for (int t = 1; t < threads; ++t) helpers.run([&walk, t] { walk.work(t); });
+    walk.work(0);
     helpers.wait();
   });
 }

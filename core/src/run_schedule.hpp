@@ -12,14 +12,24 @@
 //   hand-off between its batches (in it, a stretch of batches smaller than
 //   the lanes is a run, resolved contact after contact by the run kernel).
 //   Items are numbered across the steps and passes.
-// * The threads of the arena start once per solve and claim items from one
-//   counter, in order. Before it runs an item, a thread waits until every
-//   item of the earlier steps has finished: a second counter, which only
-//   ever counts items of steps no later than the earliest unfinished one, so
-//   reaching the step's first item number means the steps before are done
-//   (Box2D's stage counter, b2ExecuteMainStage, does the same with a stage
-//   index). A thread that waits and finds a pipelined run in progress forms
-//   its geometry (run_pipeline.hpp) instead of spinning.
+// * The threads of the arena start once per solve and walk the steps
+//   together. Before it claims an item of a step, a thread waits until every
+//   item of the earlier steps has finished: a counter of finished items,
+//   which only ever counts items of steps no later than the earliest
+//   unfinished one, so reaching the step's first item number means the
+//   steps before are done (Box2D's stage counter, b2ExecuteMainStage, does
+//   the same with a stage index). A thread that waits and finds a pipelined
+//   run in progress forms its geometry (run_pipeline.hpp) instead of
+//   spinning.
+// * Each thread has a home among a step's items: thread w of T starts at
+//   item w * items / T, claims forward until it meets an item another thread
+//   took, then backward from its home (Box2D's b2ExecuteStage and
+//   b2GetWorkerStartIndex). The items of every batch are ranges in the same
+//   place of the batch, and the colours of a window, and the levels of a
+//   pile, each reach the bodies in about the same sequence, so a thread keeps
+//   finding the bodies it wrote in its own cache instead of in the other
+//   core's; a thread that arrives late takes what its home's neighbours
+//   left.
 // * Nothing depends on which thread runs what: the contacts of a batch share
 //   no movable body, so splitting a batch differently cannot change a bit,
 //   and a thread that never arrives (the arena busy elsewhere) leaves its
