@@ -177,7 +177,10 @@ COLLIDE_LANE_INLINE GroupBodies<V::size()> group_bodies([[maybe_unused]] const V
 /// The group's bodies into lanes: every field the law reads, or with
 /// kOnlyVelocities the velocities alone (the velocity step, whose geometry
 /// is formed); a packed record's rows come whole either way.
-template <class M, class V, class T, bool kOnlyVelocities = false, class View>
+///
+/// With kPaired the caller knows the group is paired, and only that load is
+/// compiled (see solve_groups).
+template <class M, class V, class T, bool kOnlyVelocities = false, bool kPaired = false, class View>
 COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
                                            BodyLanes<M, V>& b) {
   const auto fields = [&](auto&& f) COLLIDE_LANE_LAMBDA {
@@ -187,7 +190,9 @@ COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies
       read_bodies<M, V>(bodies, a, b, f);
     }
   };
-  if constexpr (kSoaLayout<View>) {
+  if constexpr (kPaired) {
+    fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + at.a[0], la, lb); });
+  } else if constexpr (kSoaLayout<View>) {
     if (at.streams == BodyStreams::paired) {
       fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + at.a[0], la, lb); });
     } else if (at.streams == BodyStreams::runs) {
@@ -210,7 +215,7 @@ COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies
 /// The velocities the law left in the lanes, back to the group's bodies.
 /// An immovable body is never written, not even with its own value: another
 /// thread may be reading it (the ground is in many contacts of a batch).
-template <class M, class V, class T, class View>
+template <class M, class V, class T, bool kPaired = false, class View>
 COLLIDE_LANE_INLINE void store_group_bodies(const View& bodies, const GroupBodies<V::size()>& at,
                                             const BodyLanes<M, V>& a, const BodyLanes<M, V>& b) {
   const auto movable_a = a.inv_mass != V(0);
@@ -219,7 +224,7 @@ COLLIDE_LANE_INLINE void store_group_bodies(const View& bodies, const GroupBodie
     // Whole vectors only when every body is movable: a's and b's bodies are
     // then all distinct, and no immovable one is written.
     if (at.streams != BodyStreams::gathered && stdx::all_of(movable_a && movable_b)) {
-      if (at.streams == BodyStreams::paired) {
+      if (kPaired || at.streams == BodyStreams::paired) {
         write_bodies<M, V>(bodies, a, b, [&](T* field, const V& la, const V& lb) COLLIDE_LANE_LAMBDA {
           store_interleaved(la, lb, field + at.a[0]);
         });
@@ -272,13 +277,12 @@ COLLIDE_LANE_INLINE void store_group_impulses(const ImpulseView<T>& impulses, co
 
 /// Resolves one group of V::size() contacts; with `accumulate`, adds J to
 /// the impulses there (a later pass).
-template <class M, class V, bool kFriction, class Mode, class T, class View>
+template <class M, class V, bool kFriction, class Mode, bool kPaired, class T, class View>
 COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                                     const ContactGroup& g, bool accumulate) {
-  const GroupBodies<V::size()> at = group_bodies<V>(bodies, contacts, g);
+                                     const ContactGroup& g, const GroupBodies<V::size()>& at, bool accumulate) {
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
-  load_group_bodies<M, V, T>(bodies, at, a, b);
+  load_group_bodies<M, V, T, false, kPaired>(bodies, at, a, b);
 
   ContactLanes<V> c;
   if constexpr (kRotates<M>) {
@@ -289,7 +293,7 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
   if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
 
   const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
-  store_group_bodies<M, V, T>(bodies, at, a, b);
+  store_group_bodies<M, V, T, kPaired>(bodies, at, a, b);
   store_group_impulses<V>(impulses, g, r.j, accumulate);
 }
 
@@ -389,15 +393,30 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
           prefetch_record(bodies, contacts.a[order[k]]);
           prefetch_record(bodies, contacts.b[order[k]]);
         }
-        solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i},
-                                              accumulate);
+        const ContactGroup g{contiguous, order[i], order + i};
+        solve_group<M, V, kFriction, Mode, false>(bodies, contacts, impulses, g, group_bodies<V>(bodies, contacts, g),
+                                                  accumulate);
       }
       return i;
     }
   }
+  // Paired groups first, each law's inputs from one kind of load: where
+  // the three kinds of groups meet before the law, the wide kernel's 32
+  // registers do not hold both sides' lanes and spill (AVX-512 pairs ran
+  // 1.3x slower so). Independent pairs are paired from first to last; the
+  // first other group hands the rest of the range to the general loop.
+  if constexpr (kSoaLayout<View> && W > 1) {
+    for (; i + W <= end; i += W) {
+      const ContactGroup g{contiguous, order[i], order + i};
+      const GroupBodies<W> at = group_bodies<V>(bodies, contacts, g);
+      if (at.streams != BodyStreams::paired) break;
+      solve_group<M, V, kFriction, Mode, true>(bodies, contacts, impulses, g, at, accumulate);
+    }
+  }
   for (; i + W <= end; i += W) {
-    solve_group<M, V, kFriction, Mode, T>(bodies, contacts, impulses, ContactGroup{contiguous, order[i], order + i},
-                                          accumulate);
+    const ContactGroup g{contiguous, order[i], order + i};
+    solve_group<M, V, kFriction, Mode, false>(bodies, contacts, impulses, g, group_bodies<V>(bodies, contacts, g),
+                                              accumulate);
   }
   return i;
 }
