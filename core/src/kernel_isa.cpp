@@ -401,10 +401,11 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
     }
   }
   // Paired groups first, each law's inputs from one kind of load: where
-  // the three kinds of groups meet before the law, the wide kernel's 32
-  // registers do not hold both sides' lanes and spill (AVX-512 pairs ran
-  // 1.3x slower so). Independent pairs are paired from first to last; the
-  // first other group hands the rest of the range to the general loop.
+  // the three kinds of loads meet before the law, the wide kernel's 32
+  // registers cannot hold both sides' lanes and spill
+  // (docs/decisions/0033-passes-on-the-velocity-step.md). Independent pairs
+  // are paired from first to last; the first other group hands the rest of
+  // the range to the general loop.
   if constexpr (kSoaLayout<View> && W > 1) {
     for (; i + W <= end; i += W) {
       const ContactGroup g{contiguous, order[i], order + i};
