@@ -34,7 +34,7 @@ void gather(V* to, const V* from, const std::uint32_t* order, std::size_t begin,
 }  // namespace
 
 template <class T>
-void PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form) {
+KernelJob<T> PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form) {
   const ContactView<T>& contacts = job.contacts;
   const std::uint32_t* order = job.order;
   const std::size_t n = contacts.count;
@@ -66,17 +66,17 @@ void PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& jo
   v.e = contacts.e != nullptr ? e_.data() : nullptr;
   v.uniform_e = contacts.uniform_e;
   v.mu = contacts.mu != nullptr ? mu_.data() : nullptr;
-  view_ = v;
   impulses_.count = n;
   impulses_.j = {j_[0].data(), j_[1].data(), j_[2].data()};
   KernelJob<T> on_prepared = job;
-  on_prepared.contacts = view_;
+  on_prepared.contacts = v;
   on_prepared.impulses = impulses_;
   on_prepared.order = identity_.data();
-  geometry_view_ = {};
+  on_prepared.stepped = form != nullptr;
+  on_prepared.geometry = {};
   if (form != nullptr) {
     for (ScratchVector<T>& values : geometry_) values.resize(n);
-    GeometryView<T>& g = geometry_view_;
+    GeometryView<T>& g = on_prepared.geometry;
     for (std::size_t k = 0; k < 3; ++k) {
       g.ra[k] = geometry_[k].data();
       g.rb[k] = geometry_[3 + k].data();
@@ -104,8 +104,9 @@ void PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& jo
     if (contacts.mu != nullptr) gather(mu_.data(), contacts.mu, order, begin, end);
     // Positions and orientations are the bodies' as the solve starts: no
     // contact changes them, so the geometry formed now serves every pass.
-    if (form != nullptr) form(on_prepared, begin, end - begin, geometry_view_.from(begin));
+    if (form != nullptr) form(on_prepared, begin, end - begin, on_prepared.geometry.from(begin));
   });
+  return on_prepared;
 }
 
 template <class T>

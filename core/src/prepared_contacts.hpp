@@ -50,17 +50,12 @@ class PreparedContacts {
  public:
   /// Copies the job's contacts order[0], order[1], ... (contacts.count of
   /// them) into the prepared arrays, on the threads of `arena`; with `form`
-  /// (the run geometry kernel of the solve's ISA), forms their geometry too
-  /// (geometry()), from the job's bodies. Allocates only when the count
-  /// exceeds every count before.
-  void prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form = nullptr);
-
-  /// The prepared contacts, their J (written by the solve) and their order.
-  [[nodiscard]] ContactView<T> contacts() const { return view_; }
-  [[nodiscard]] ImpulseView<T> impulses() const { return impulses_; }
-  [[nodiscard]] const std::uint32_t* identity() const { return identity_.data(); }
-  /// The geometry the last prepare formed, by position (with `form` only).
-  [[nodiscard]] GeometryView<T> geometry() const { return geometry_view_; }
+  /// (the run geometry kernel of the solve's ISA), forms their geometry too,
+  /// from the job's bodies. Returns the job on the prepared arrays: their
+  /// contacts and J, the identity order, and with `form` the geometry
+  /// (KernelJob::stepped). Allocates only when the count exceeds every
+  /// count before.
+  KernelJob<T> prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form = nullptr);
 
   /// J of position i to impulses[order[i]], for every prepared contact.
   void write_back(tbb::task_arena& arena, const ImpulseView<T>& impulses, const std::uint32_t* order) const;
@@ -70,9 +65,7 @@ class PreparedContacts {
   ScratchVector<T> c_[3], n_[3], e_, mu_, j_[3];
   ScratchVector<std::uint32_t> identity_;
   ScratchVector<T> geometry_[16];
-  ContactView<T> view_;
   ImpulseView<T> impulses_;
-  GeometryView<T> geometry_view_;
 };
 
 extern template class PreparedContacts<float>;

@@ -164,14 +164,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const std::lock_guard<std::mutex> lock(prepare_mutex);
     detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
-    prepared_contacts.prepare(
+    const detail::KernelJob<T> on_prepared = prepared_contacts.prepare(
         *arena, job, stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
-    detail::KernelJob<T> on_prepared = job;
-    on_prepared.contacts = prepared_contacts.contacts();
-    on_prepared.impulses = prepared_contacts.impulses();
-    on_prepared.order = prepared_contacts.identity();
-    on_prepared.stepped = stepped;
-    on_prepared.geometry = prepared_contacts.geometry();
     plan.prepared = true;
     detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());
