@@ -302,6 +302,24 @@ COLLIDE_LANE_INLINE Vec3<V> load3(typename V::value_type* const (&from)[3], std:
   return {load<V>(from[0] + at), load<V>(from[1] + at), load<V>(from[2] + at)};
 }
 
+/// The stored geometry of the contacts at position `at` (V::size() of them)
+/// and their bodies' inverse masses, as contact_geometry formed them: what
+/// the velocity step reads (step_group in lanes, piece_walk in one).
+template <class M, class V, class T>
+COLLIDE_LANE_INLINE ContactGeometry<V> stored_geometry(const GeometryView<T>& geometry, std::size_t at,
+                                                       BodyLanes<M, V>& a, BodyLanes<M, V>& b) {
+  a.inv_mass = load<V>(geometry.inv_mass_a + at);
+  b.inv_mass = load<V>(geometry.inv_mass_b + at);
+  ContactGeometry<V> g{};
+  if constexpr (kRotates<M>) {
+    g.ra = load3<V>(geometry.ra, at);
+    g.rb = load3<V>(geometry.rb, at);
+    g.arm_a = {load3<V>(geometry.response_a, at), load<V>(geometry.k_a + at)};
+    g.arm_b = {load3<V>(geometry.response_b, at), load<V>(geometry.k_b + at)};
+  }
+  return g;
+}
+
 /// The velocity step of one group of V::size() consecutive contacts at
 /// `first`, whose geometry is formed (KernelJob::stepped): the second half
 /// of the law on the first half's stored values, so the bits are those of
@@ -314,15 +332,7 @@ COLLIDE_LANE_INLINE void step_group(const View& bodies, const ContactView<T>& co
   BodyLanes<M, V> a;
   BodyLanes<M, V> b;
   load_group_bodies<M, V, T, true>(bodies, at, a, b);
-  a.inv_mass = load<V>(geometry.inv_mass_a + first);
-  b.inv_mass = load<V>(geometry.inv_mass_b + first);
-  ContactGeometry<V> geo{};
-  if constexpr (kRotates<M>) {
-    geo.ra = load3<V>(geometry.ra, first);
-    geo.rb = load3<V>(geometry.rb, first);
-    geo.arm_a = {load3<V>(geometry.response_a, first), load<V>(geometry.k_a + first)};
-    geo.arm_b = {load3<V>(geometry.response_b, first), load<V>(geometry.k_b + first)};
-  }
+  const ContactGeometry<V> geo = stored_geometry(geometry, first, a, b);
   ContactLanes<V> c;
   c.n = {load<V>(contacts.n.x + first), load<V>(contacts.n.y + first), load<V>(contacts.n.z + first)};
   c.e = contacts.e ? load<V>(contacts.e + first) : V(contacts.uniform_e);
@@ -593,20 +603,12 @@ void piece_walk(const View& bodies, const ContactView<T>& contacts, const Impuls
     const BodyIndex ib = contacts.b[k];
     BodyLanes<M, S> a;
     BodyLanes<M, S> b;
-    a.inv_mass = S(geometry.inv_mass_a[j]);
-    b.inv_mass = S(geometry.inv_mass_b[j]);
+    const ContactGeometry<S> g = stored_geometry(geometry, j, a, b);
     read_velocities<M, S>(bodies, ia, a);
     read_velocities<M, S>(bodies, ib, b);
     ContactLanes<S> c;
     c.n = {S(contacts.n.x[k]), S(contacts.n.y[k]), S(contacts.n.z[k])};
     c.e = S(contacts.e != nullptr ? contacts.e[k] : contacts.uniform_e);
-    ContactGeometry<S> g{};
-    if constexpr (kRotates<M>) {
-      g.ra = load3<S>(geometry.ra, j);
-      g.rb = load3<S>(geometry.rb, j);
-      g.arm_a = {load3<S>(geometry.response_a, j), S(geometry.k_a[j])};
-      g.arm_b = {load3<S>(geometry.response_b, j), S(geometry.k_b[j])};
-    }
     ContactResult<S> r = velocity_step<M, S, false, FastMode>(a, b, c, g);
     canonical_outputs(a, b, r.j);  // as resolve_contacts
     Vec3<S> jv = r.j;
