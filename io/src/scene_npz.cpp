@@ -24,8 +24,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -303,25 +301,6 @@ LoadedBodies<T> load_bodies(const std::string& path, SceneFormat format, BodyRul
 }
 
 template <class T>
-void SolveBodies<T>::Free::operator()(T* p) const noexcept {
-  std::free(p);
-}
-
-namespace {
-/// Uncleared memory for n values of T, in 2 MiB pages where the kernel gives
-/// them (madvise), so that first touch faults once per 2 MiB, not per 4 KiB.
-template <class T>
-T* allocate_large(std::size_t n) {
-  constexpr std::size_t kHuge = std::size_t{2} << 20;
-  const std::size_t bytes = std::max<std::size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
-  void* p = std::aligned_alloc(kHuge, bytes);
-  if (p == nullptr) throw std::bad_alloc();
-  ::madvise(p, bytes, MADV_HUGEPAGE);
-  return static_cast<T*>(p);
-}
-}  // namespace
-
-template <class T>
 BodyView<T> SolveBodies<T>::point_at(const BodyColumns<T>& columns) {
   for (std::size_t k = 0; k < read_.size(); ++k) read_[k] = columns.column[4 + k];
   return view();
@@ -329,7 +308,7 @@ BodyView<T> SolveBodies<T>::point_at(const BodyColumns<T>& columns) {
 
 template <class T>
 SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
-    : count_(columns.count), own_(allocate_large<T>(10 * columns.count)) {
+    : count_(columns.count), own_(detail::allocate_large_array<T>(10 * columns.count)) {
   const BodyView<T> v = point_at(columns);
   if (!screened_solve_arrays(columns, v.inv_mass, v.inv_inertia, v.v, v.w)) {
     const std::optional<RowDefect> bad = first_body_defect(columns);
@@ -341,7 +320,7 @@ SolveBodies<T>::SolveBodies(const BodyColumns<T>& columns)
 
 template <class T>
 SolveBodies<T>::SolveBodies(const LoadedBodies<T>& loaded)
-    : count_(loaded.size()), own_(allocate_large<T>(10 * loaded.size())) {
+    : count_(loaded.size()), own_(detail::allocate_large_array<T>(10 * loaded.size())) {
   const BodyView<T> v = point_at(loaded.columns());
   loaded.fill_solve_arrays(v.inv_mass, v.inv_inertia, v.v, v.w);
 }

@@ -22,6 +22,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "collide/large_allocator.hpp"
+
 // __float128 (113-bit significand) exists with GCC on x86-64. collide::eval
 // instantiates the body and contact buffers and the reference
 // (collide/eval/reference.hpp, with libquadmath's sqrtq) for it there, to
@@ -214,8 +216,9 @@ class BodyBuffer {
   [[nodiscard]] BodyView<const T> view() const;
 
  private:
-  std::vector<T> inv_mass_, ix_, iy_, iz_, qw_, qx_, qy_, qz_;
-  std::vector<T> px_, py_, pz_, vx_, vy_, vz_, wx_, wy_, wz_;
+  using Column = std::vector<T, LargeAllocator<T>>;
+  Column inv_mass_, ix_, iy_, iz_, qw_, qx_, qy_, qz_;
+  Column px_, py_, pz_, vx_, vy_, vz_, wx_, wy_, wz_;
 };
 
 /// True for the inverse mass of an immovable body: 0, whatever the moments

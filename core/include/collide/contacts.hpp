@@ -13,6 +13,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "collide/large_allocator.hpp"
+
 #include "collide/bodies.hpp"
 
 namespace collide {
@@ -115,8 +117,8 @@ class ContactBuffer {
   [[nodiscard]] bool has_friction() const;
 
  private:
-  std::vector<BodyIndex> a_, b_;
-  std::vector<T> cx_, cy_, cz_, nx_, ny_, nz_, e_, mu_;
+  std::vector<BodyIndex, LargeAllocator<BodyIndex>> a_, b_;
+  std::vector<T, LargeAllocator<T>> cx_, cy_, cz_, nx_, ny_, nz_, e_, mu_;
 };
 
 /// Owning storage for impulses.
@@ -135,7 +137,7 @@ class ImpulseBuffer {
   [[nodiscard]] ImpulseView<const T> view() const { return {x_.size(), {x_.data(), y_.data(), z_.data()}}; }
 
  private:
-  std::vector<T> x_, y_, z_;
+  std::vector<T, LargeAllocator<T>> x_, y_, z_;
 };
 
 extern template class ContactBuffer<float>;

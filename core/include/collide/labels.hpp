@@ -14,13 +14,15 @@
 #include <utility>
 #include <vector>
 
+#include "collide/large_allocator.hpp"
+
 namespace collide {
 
 /// The allocator of Labels: std::allocator's, except that resize() leaves
 /// the new values uninitialised (their owner writes every one, in parallel
 /// passes; a std::vector would first zero them on one thread, a third of
-/// islands() at 16M contacts) and that arrays of 2 MiB or more are asked for
-/// 2 MiB pages where the system has them.
+/// islands() at 16M contacts), on LargeAllocator's memory (huge pages from
+/// 2 MiB on).
 struct LabelAllocator {
   using value_type = std::uint32_t;
   template <class U>
@@ -29,8 +31,8 @@ struct LabelAllocator {
     using other = LabelAllocator;
   };
 
-  [[nodiscard]] std::uint32_t* allocate(std::size_t n);
-  void deallocate(std::uint32_t* p, std::size_t n) noexcept;
+  [[nodiscard]] std::uint32_t* allocate(std::size_t n) { return detail::allocate_large_array<std::uint32_t>(n); }
+  void deallocate(std::uint32_t* p, std::size_t) noexcept { detail::free_large(p); }
   /// Value-initialisation (resize(n)) leaves the value as it is.
   void construct(std::uint32_t* p) noexcept { ::new (static_cast<void*>(p)) std::uint32_t; }
   template <class... Args>

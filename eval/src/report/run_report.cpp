@@ -30,20 +30,18 @@
 //   scene. Deriving in place, rigid then sphere then particle, needs no copy
 //   of a scene of millions of bodies.
 // * Budget (the default run is README command 1 and must take a few
-//   minutes on a 2-core machine): the pairs scene has --n collisions (4M by
+//   minutes on a 2-core machine): the pairs scene has --n collisions (1M by
 //   default); the debris scene min(--n, 1M) unless --debris-n says otherwise,
 //   because its random body accesses make it 3 to 10 times slower per
-//   collision (latency-bound gathers), and 48 kernel rows of five runs of 4M
-//   debris collisions took 400 s here. The pile scene likewise has at most
+//   collision (latency-bound gathers): 48 kernel rows of five runs of 4M
+//   debris collisions take minutes. The pile scene likewise has at most
 //   min(--n, 1M) contacts unless --pile-n says otherwise (the largest cubic
 //   pile within it: 69^3 boxes, 976005 contacts); its contacts reach nearby
 //   bodies in cell order, but share them in chains some 9 x side batches
 //   deep. The slow rows (the reference in long double and in double, the
 //   textbook loop, the Bullet peer; single-threaded by nature) are timed on
-//   the first 500k contacts only; the row's n and
-//   note say so. Their per-collision speed does not depend on n once the
-//   scene is out of the last-level cache, which 500k contacts are in every
-//   precision (46 MB of bodies and more).
+//   the first slow_n contacts only (200k by default, report.hpp), which
+//   keeps each to a second or so; the row's n and note say so.
 // * The N sweep (panel 2 of the plot) runs on prefixes of one pairs scene of
 //   the largest N: the first N pairs of the pairs scene are the N-pair scene.
 // * The hard section (--hard, hard_rows.cpp) runs after the three scenes:

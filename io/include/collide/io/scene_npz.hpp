@@ -49,6 +49,7 @@
 #include "collide/io/npz.hpp"
 #include "collide/io/output_file.hpp"
 #include "collide/io/scene_io.hpp"
+#include "collide/large_allocator.hpp"
 
 namespace collide {
 
@@ -155,11 +156,8 @@ class SolveBodies {
   /// q and p pointed at `columns`; the view of the arrays to fill.
   BodyView<T> point_at(const BodyColumns<T>& columns);
   std::size_t count_ = 0;
-  struct Free {
-    void operator()(T* p) const noexcept;
-  };
-  std::unique_ptr<T[], Free> own_;  // inv_mass, Ix, Iy, Iz, vx, vy, vz, wx, wy, wz: 10 runs of count_
-  std::array<const T*, 7> read_{};  // qw, qx, qy, qz, px, py, pz
+  std::unique_ptr<T[], detail::FreeLarge> own_;  // inv_mass, Ix, Iy, Iz, vx, vy, vz, wx, wy, wz: 10 runs of count_
+  std::array<const T*, 7> read_{};               // qw, qx, qy, qz, px, py, pz
 };
 
 /// Reads a bodies file (CSV: read_bodies; binary: mapped, and checked
