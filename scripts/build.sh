@@ -1,15 +1,28 @@
 #!/usr/bin/env bash
 # Configures and builds collide (Release) into build/, after installing what is missing.
 #   scripts/build.sh [--target T]... [CMAKE_OPTION]...
-# builds every target, or only the targets named (README command 1 builds
-# only the `collide` tool: --target collide_cli); other arguments go to the
-# configure step.
+#       everything (libraries, tool, tests, benchmarks, Python, examples), or
+#       only the targets named; README command 2
+#   scripts/build.sh --tool [CMAKE_OPTION]...
+#       the `collide` tool alone, with only its packages (install-deps.sh
+#       --tool) and the tests, benchmarks, Python and examples configured
+#       off, so none of their packages is needed; README command 1
+# Other arguments go to the configure step after the script's own options,
+# so they win. Either way every part is named ON or OFF, so a build/ that
+# one configured is reconfigured by the other.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+state=ON
+deps=()
 targets=()
 configure=()
 while [ $# -gt 0 ]; do
-  if [ "$1" = --target ] && [ $# -ge 2 ]; then
+  if [ "$1" = --tool ]; then
+    state=OFF
+    deps=(--tool)
+    targets=(--target collide_cli)
+    shift
+  elif [ "$1" = --target ] && [ $# -ge 2 ]; then
     targets+=(--target "$2")
     shift 2
   else
@@ -17,7 +30,9 @@ while [ $# -gt 0 ]; do
     shift
   fi
 done
-"$root/scripts/install-deps.sh"
+"$root/scripts/install-deps.sh" "${deps[@]}"
+options=(-DCOLLIDE_BUILD_CLI=ON)
+for part in TESTS BENCH PYTHON EXAMPLES; do options+=("-DCOLLIDE_BUILD_$part=$state"); done
 # With ccache, paths hashed relative to the build directory (CCACHE_BASEDIR),
 # so that the pip install test (setup.py, same layout) reuses these objects.
 launcher=()
@@ -25,5 +40,5 @@ if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
 fi
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${configure[@]}" >/dev/null
+cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${options[@]}" "${configure[@]}" >/dev/null
 cmake --build "$root/build" -j"$(nproc)" "${targets[@]}"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# README command 1: install what is missing, build the `collide` tool (only
-# it: not the tests, benchmarks, examples or the Python module), and run the
+# README command 1: install the packages the tool needs (install-deps.sh
+# --tool), build the `collide` tool (only it: not the tests, benchmarks,
+# examples or the Python module, which are configured off), and run the
 # main job, `collide report` with its default settings (docs/report.md): the
 # speed and the error of every variant on 1,000,000 random pairs, a debris
 # scene of 1,000,000 contacts and a pile of 976,005, as a summary on stdout
@@ -19,7 +20,7 @@
 # not stop the rest; the script exits with the first failure's status.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$root/scripts/build.sh" --target collide_cli
+"$root/scripts/build.sh" --tool
 
 status=0
 # shellcheck disable=SC2086  # REPORT_ARGS is a list of options

@@ -1,25 +1,42 @@
 #!/usr/bin/env bash
 # Installs, from Debian's packages, whatever the build needs and is missing.
 # Downloads nothing else. Run as root, or with sudo available.
+#   scripts/install-deps.sh          everything: the libraries, the tools, the
+#                                    tests, the benchmarks, Python, sanitizers
+#   scripts/install-deps.sh --tool   only what the `collide` tool's build and
+#                                    its report need (README command 1)
 set -euo pipefail
 
-# libdeflate-dev: the CRC-32 of the .npz scene writer.
-# gnuplot-nox draws the report's plot and the debris example's picture;
+# The tool: the compiler and CMake; TBB (the threads), libdeflate-dev (the
+# CRC-32 of the .npz scene writer), pkg-config (which finds libdeflate);
+# gnuplot-nox draws the report's plot (and the debris example's picture);
 # libbullet-dev gives `collide report` its peer row (optional in CMake).
+# ccache: scripts/build.sh and setup.py compile through it when present, so the
+# pip install test reuses the normal build's objects (python/CMakeLists.txt).
+tool=(g++ cmake make ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox libbullet-dev)
+# The rest: Eigen (the tests' cross-check and the benchmarks' lane
+# comparison), Google Benchmark and GoogleTest.
+# clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
+# scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh.
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
 # tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
 # no network (venv, setuptools, pip).
 # python3-dask, python3-distributed, python3-pandas: collide.dask (python/collide/dask),
 # the solve split across Dask workers by islands and solve_scenes' table, and its
 # tests on a LocalCluster (tests/python/test_dask.py); `import collide` does not need them.
-# ccache: scripts/build.sh and setup.py compile through it when present, so the
-# pip install test reuses the normal build's objects (python/CMakeLists.txt).
-# clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
-# scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh.
-packages=(g++ cmake make ccache pkg-config libeigen3-dev libtbb-dev libdeflate-dev libbenchmark-dev libgtest-dev gnuplot-nox libbullet-dev
+rest=(libeigen3-dev libbenchmark-dev libgtest-dev
   clang-14 libclang-rt-14-dev clang-tidy-14
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip
   python3-dask python3-distributed python3-pandas)
+
+case "${1:-}" in
+  "") packages=("${tool[@]}" "${rest[@]}") ;;
+  --tool) packages=("${tool[@]}") ;;
+  *)
+    echo "usage: scripts/install-deps.sh [--tool]" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
