@@ -13,9 +13,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "collide/large_allocator.hpp"
-
 #include "collide/bodies.hpp"
+#include "collide/large_allocator.hpp"
 
 namespace collide {
 
