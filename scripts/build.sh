@@ -6,19 +6,22 @@
 #   scripts/build.sh --tool [CMAKE_OPTION]...
 #       the `collide` tool alone, with only its packages (install-deps.sh
 #       --tool) and the tests, benchmarks, Python and examples configured
-#       off, so none of their packages is needed; README command 1
+#       off, so none of their packages is needed, and its sources compiled
+#       in unity batches (COLLIDE_UNITY_BUILD); README command 1
 # Other arguments go to the configure step after the script's own options,
 # so they win. Either way every part is named ON or OFF, so a build/ that
 # one configured is reconfigured by the other.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 state=ON
+unity=OFF
 deps=()
 targets=()
 configure=()
 while [ $# -gt 0 ]; do
   if [ "$1" = --tool ]; then
     state=OFF
+    unity=ON
     deps=(--tool)
     targets=(--target collide_cli)
     shift
@@ -31,7 +34,7 @@ while [ $# -gt 0 ]; do
   fi
 done
 "$root/scripts/install-deps.sh" "${deps[@]}"
-options=(-DCOLLIDE_BUILD_CLI=ON)
+options=(-DCOLLIDE_BUILD_CLI=ON -DCOLLIDE_UNITY_BUILD=$unity)
 for part in TESTS BENCH PYTHON EXAMPLES; do options+=("-DCOLLIDE_BUILD_$part=$state"); done
 # With ccache, paths hashed relative to the build directory (CCACHE_BASEDIR),
 # so that the pip install test (setup.py, same layout) reuses these objects.

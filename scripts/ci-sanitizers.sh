@@ -18,7 +18,10 @@
 #      (COLLIDE_KERNEL_ISAS=sse2: 4 float and 2 double lanes, and the
 #      one-lane kernel of every path): the kernel is one body over the lane
 #      type (kernel_isa.cpp), so a wider copy adds minutes of compile time
-#      and no code of its own, and the Release stage runs every ISA's.
+#      and no code of its own, and the Release stage runs every ISA's. The
+#      libraries and the tool compile in unity batches (COLLIDE_UNITY_BUILD,
+#      as README command 1 builds them), so two sources of a batch that
+#      define one name fail here.
 #   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 45),
 #      the targets side by side on the available cores, from a scratch copy of
 #      fuzz/corpus/<target>/ (the committed seeds stay as they are). A crash,
@@ -55,7 +58,7 @@ stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
 asan="$root/build-asan"
 stage "ASan+UBSan build"
 cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" \
-  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON -DCOLLIDE_KERNEL_ISAS=sse2 \
+  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON -DCOLLIDE_KERNEL_ISAS=sse2 -DCOLLIDE_UNITY_BUILD=ON \
   -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$asan" -j"$jobs"
 stage "ASan+UBSan tests"

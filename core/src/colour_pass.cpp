@@ -32,10 +32,6 @@ constexpr std::uint32_t kLastTag = 0xFE;
 /// The label of a contact in its window's overflow.
 constexpr std::uint8_t kOverflow = kColours;
 
-/// Contacts ahead whose table words the colouring prefetches (as the level
-/// pass, level_pass.cpp).
-constexpr std::size_t kPrefetchDistance = 16;
-
 inline bool movable(std::uint32_t word) { return (word >> kTagShift) != kImmovableTag; }
 
 /// One thread's tables, for the windows it colours.

@@ -10,11 +10,6 @@
 namespace collide::detail {
 namespace {
 
-/// Contacts ahead whose bodies the pass prefetches. Measured on the debris
-/// scene at 2M and 4M contacts: 8 leaves misses exposed, 16 to 64 are within
-/// 5% of each other.
-constexpr std::size_t kPrefetchDistance = 16;
-
 /// Contacts checked at a time before their indices are used: 2 KiB of
 /// indices, still in L1 when the pass reads them (1024 measured slower).
 constexpr std::size_t kCheckBlock = 256;

@@ -1,6 +1,6 @@
 // schedule_input.hpp - what the passes of a schedule read (private to the
 // library): the contacts' body indices and the bodies' inverse masses,
-// whatever the body layout.
+// whatever the body layout, and how far ahead the passes prefetch.
 #pragma once
 
 #include <cstddef>
@@ -28,5 +28,10 @@ struct InverseMasses {
 
   [[nodiscard]] bool immovable(std::size_t i) const { return is_immovable(data[i * stride]); }
 };
+
+/// Contacts ahead whose bodies' table entries the level and colour passes
+/// prefetch. Measured on the debris scene at 2M and 4M contacts: 8 leaves
+/// misses exposed, 16 to 64 are within 5% of each other.
+inline constexpr std::size_t kPrefetchDistance = 16;
 
 }  // namespace collide::detail

@@ -235,15 +235,22 @@ class Runner {
     return *slot;
   }
 
-  /// The kernel rows of one scene: the scalar path, the SIMD path (the
-  /// default ISA) and the SIMD path in the accurate mode (variant
-  /// "accurate") at every thread count, and SIMD on every other ISA the CPU
-  /// has at the first. The default ISA is default_isa() (COLLIDE_ISA, else
-  /// the widest), named, so that every row says which ISA it timed whatever
-  /// Isa::automatic would measure; the machine block shows those picks.
+  /// The kernel rows of one scene: the SIMD path (the default ISA) and the
+  /// SIMD path in the accurate mode (variant "accurate") at every thread
+  /// count; the scalar path, and SIMD on every other ISA the CPU has, at the
+  /// first. The scalar path gives the SIMD path's bits, so its rows are the
+  /// baseline of the lanes' gain, which one thread count shows (its rows at
+  /// every count were a tenth of the default run). The default ISA is
+  /// default_isa() (COLLIDE_ISA, else the widest), named, so that every row
+  /// says which ISA it timed whatever Isa::automatic would measure; the
+  /// machine block shows those picks.
   [[nodiscard]] std::vector<std::tuple<Path, int, Isa, Accuracy>> kernel_variants() const {
     std::vector<std::tuple<Path, int, Isa, Accuracy>> v;
     for (const auto& [path, accuracy] : kKernelVariants) {
+      if (path == Path::scalar) {
+        v.emplace_back(path, config_.threads.front(), default_isa(), accuracy);
+        continue;
+      }
       for (const int threads : config_.threads) v.emplace_back(path, threads, default_isa(), accuracy);
     }
     for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
