@@ -161,7 +161,7 @@ bool schedule_window(const ContactIndices& c, const InverseMasses<T>& inv_mass, 
   }
   const std::size_t overflow = w1 - slot[kOverflow];
   // Mostly one colour (a scattered scene): runs keep their slot in a register.
-  const bool runs = 2 * (slot[1] - slot[0]) > w1 - w0;
+  const bool runs = std::size_t{2} * (slot[1] - slot[0]) > w1 - w0;
   scatter_by_level(label, w0, w1, slot, order, runs);
   if (overflow != 0) {
     t.summary.overflow += overflow;

@@ -174,38 +174,68 @@ COLLIDE_LANE_INLINE GroupBodies<V::size()> group_bodies([[maybe_unused]] const V
   return at;
 }
 
-/// The group's bodies into lanes: every field the law reads, or with
-/// kOnlyVelocities the velocities alone (the velocity step, whose geometry
-/// is formed); a packed record's rows come whole either way.
+/// Calls f(field, lane_of_a, lane_of_b) for every field a group's load
+/// reads: every field the law reads, or with kOnlyVelocities the velocities
+/// alone (the velocity step, whose geometry is formed).
+template <class M, class V, bool kOnlyVelocities, class View, class F>
+COLLIDE_LANE_INLINE void loaded_fields(const View& bodies, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
+  if constexpr (kOnlyVelocities) {
+    velocity_fields<M>(bodies, a, b, f);
+  } else {
+    read_bodies<M, V>(bodies, a, b, f);
+  }
+}
+
+/// The group's bodies from the SoA arrays by the load its BodyStreams name.
+template <class M, class V, class T, bool kOnlyVelocities, class View>
+COLLIDE_LANE_INLINE void load_streams(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
+                                      BodyLanes<M, V>& b) {
+  if (at.streams == BodyStreams::paired) {
+    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      load_deinterleaved(field + at.a[0], la, lb);
+    });
+  } else if (at.streams == BodyStreams::runs) {
+    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      la = load<V>(field + at.a[0]);
+      lb = load<V>(field + at.b[0]);
+    });
+  } else {
+    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      la = gather<V>(field, at.a);
+      lb = gather<V>(field, at.b);
+    });
+  }
+}
+
+/// load_streams as a call, for the SIMD kernels' full loads. Where the three
+/// loads meet inside the law's function, the AVX-512 kernel's 32 registers
+/// cannot hold both sides' lanes and it spills inside the law (decision
+/// 0033); called, the loaded lanes pass through memory once, into the law's
+/// first loads. The pile in cache (64Ki contacts, one thread, AVX-512) runs
+/// 10-12% faster in either order so; pairs never come here (their loop
+/// knows they are paired), and the velocity step's six fields gain nothing.
+template <class M, class V, class T, class View>
+__attribute__((noinline)) void load_streams_out_of_line(const View& bodies, const GroupBodies<V::size()>& at,
+                                                        BodyLanes<M, V>& a, BodyLanes<M, V>& b) {
+  load_streams<M, V, T, false>(bodies, at, a, b);
+}
+
+/// The group's bodies into lanes (loaded_fields); a packed record's rows
+/// come whole either way.
 ///
 /// With kPaired the caller knows the group is paired, and only that load is
 /// compiled (see solve_groups).
 template <class M, class V, class T, bool kOnlyVelocities = false, bool kPaired = false, class View>
 COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
                                            BodyLanes<M, V>& b) {
-  const auto fields = [&](auto&& f) COLLIDE_LANE_LAMBDA {
-    if constexpr (kOnlyVelocities) {
-      velocity_fields<M>(bodies, a, b, f);
-    } else {
-      read_bodies<M, V>(bodies, a, b, f);
-    }
-  };
   if constexpr (kPaired) {
-    fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + at.a[0], la, lb); });
+    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+      load_deinterleaved(field + at.a[0], la, lb);
+    });
+  } else if constexpr (kSoaLayout<View> && V::size() > 1 && !kOnlyVelocities) {
+    load_streams_out_of_line<M, V, T>(bodies, at, a, b);
   } else if constexpr (kSoaLayout<View>) {
-    if (at.streams == BodyStreams::paired) {
-      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA { load_deinterleaved(field + at.a[0], la, lb); });
-    } else if (at.streams == BodyStreams::runs) {
-      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-        la = load<V>(field + at.a[0]);
-        lb = load<V>(field + at.b[0]);
-      });
-    } else {
-      fields([&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-        la = gather<V>(field, at.a);
-        lb = gather<V>(field, at.b);
-      });
-    }
+    load_streams<M, V, T, kOnlyVelocities>(bodies, at, a, b);
   } else {
     read_records<M, V>(bodies, at.a, a);
     read_records<M, V>(bodies, at.b, b);
