@@ -211,9 +211,9 @@ COLLIDE_LANE_INLINE void load_streams(const View& bodies, const GroupBodies<V::s
 /// loads meet inside the law's function, the AVX-512 kernel's 32 registers
 /// cannot hold both sides' lanes and it spills inside the law (decision
 /// 0033); called, the loaded lanes pass through memory once, into the law's
-/// first loads. The pile in cache (64Ki contacts, one thread, AVX-512) runs
-/// 10-12% faster in either order so; pairs never come here (their loop
-/// knows they are paired), and the velocity step's six fields gain nothing.
+/// first loads, which costs less (decision 0035). Pairs never come here
+/// (their loop knows they are paired), and the velocity step's six fields
+/// are too few to spill.
 template <class M, class V, class T, class View>
 __attribute__((noinline)) void load_streams_out_of_line(const View& bodies, const GroupBodies<V::size()>& at,
                                                         BodyLanes<M, V>& a, BodyLanes<M, V>& b) {

@@ -239,8 +239,8 @@ class Runner {
   /// SIMD path in the accurate mode (variant "accurate") at every thread
   /// count; the scalar path, and SIMD on every other ISA the CPU has, at the
   /// first. The scalar path gives the SIMD path's bits, so its rows are the
-  /// baseline of the lanes' gain, which one thread count shows (its rows at
-  /// every count were a tenth of the default run). The default ISA is
+  /// baseline of the lanes' gain, which one thread count shows (at every
+  /// count they would be a tenth of the default run). The default ISA is
   /// default_isa() (COLLIDE_ISA, else the widest), named, so that every row
   /// says which ISA it timed whatever Isa::automatic would measure; the
   /// machine block shows those picks.
