@@ -104,8 +104,8 @@ option(COLLIDE_BUILD_EXAMPLES "Build the examples" ${_collide_tools_default})
 option(COLLIDE_BUILD_FUZZ "Build the libFuzzer targets (needs clang)" OFF)
 # Unity batches (CMake's UNITY_BUILD, 8 sources a batch) for the libraries and
 # the tool: their ~60 sources parse the same standard and TBB headers, and in
-# batches they compile in about half the compiler time (the kernel objects,
-# one source each, are as they were). For a build that only runs the tool
+# batches they compile in about two fifths of the compiler time (the kernel
+# objects, one source each, are as they were). For a build that only runs the tool
 # (scripts/build.sh --tool, README command 1). Off by default: a per-source
 # build keeps compile_commands.json per source for clang-tidy and rebuilds
 # one source per edit. scripts/ci-sanitizers.sh builds with it on, so a name
