@@ -16,10 +16,10 @@
 // * Why windows, when Box2D colours a whole island: a window's contacts and
 //   the bodies they reach stay in cache while its colours run one after
 //   another, so a pile or a chain in a broadphase's cell order reads its
-//   contacts and bodies from memory about once per pass, not once per colour;
-//   the contacts are solved from the caller's arrays where they are, with
-//   nothing copied; and the windows are coloured independently, in parallel,
-//   with the same colours for any thread count.
+//   contacts and bodies from memory about once per pass, not once per colour
+//   (the copy into the solve order, prepared_contacts.hpp, reads a window's
+//   contacts colour after colour the same way); and the windows are coloured
+//   independently, in parallel, with the same colours for any thread count.
 // * The colouring reads two words of a per-thread body table per contact:
 //   24 colour bits and a tag that says which window they belong to (so no
 //   pass clears them between windows), or that the body is immovable. Like
