@@ -25,6 +25,15 @@ set(COLLIDE_FP_FLAGS -ffp-contract=off -fno-fast-math)
 
 add_library(collide_build_flags INTERFACE)
 target_compile_options(collide_build_flags INTERFACE ${COLLIDE_FP_FLAGS} -Wall -Wextra -Wpedantic)
+# In unity batches (COLLIDE_UNITY_BUILD, cmake/options.cmake) each source is
+# included into a batch file, so GCC's -Wsubobject-linkage, which is meant
+# for headers, reports every lambda of a source that captures a type of the
+# source's anonymous namespace. A source is included once, so no such type
+# can meet its namesake; the per-source build keeps the warning and shows
+# one that would be real.
+if(COLLIDE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(collide_build_flags INTERFACE -Wno-subobject-linkage)
+endif()
 
 # ---------------------------------------------------------------------------
 # The kernel ISAs (which ones are built: COLLIDE_KERNEL_ISAS, cmake/options.cmake).
