@@ -186,14 +186,22 @@ COLLIDE_LANE_INLINE void loaded_fields(const View& bodies, BodyLanes<M, V>& a, B
   }
 }
 
+/// A paired group's bodies (BodyStreams::paired): two vector loads and a
+/// deinterleave per field.
+template <class M, class V, class T, bool kOnlyVelocities, class View>
+COLLIDE_LANE_INLINE void load_paired(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
+                                     BodyLanes<M, V>& b) {
+  loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
+    load_deinterleaved(field + at.a[0], la, lb);
+  });
+}
+
 /// The group's bodies from the SoA arrays by the load its BodyStreams name.
 template <class M, class V, class T, bool kOnlyVelocities, class View>
 COLLIDE_LANE_INLINE void load_streams(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
                                       BodyLanes<M, V>& b) {
   if (at.streams == BodyStreams::paired) {
-    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-      load_deinterleaved(field + at.a[0], la, lb);
-    });
+    load_paired<M, V, T, kOnlyVelocities>(bodies, at, a, b);
   } else if (at.streams == BodyStreams::runs) {
     loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
       la = load<V>(field + at.a[0]);
@@ -229,9 +237,7 @@ template <class M, class V, class T, bool kOnlyVelocities = false, bool kPaired 
 COLLIDE_LANE_INLINE void load_group_bodies(const View& bodies, const GroupBodies<V::size()>& at, BodyLanes<M, V>& a,
                                            BodyLanes<M, V>& b) {
   if constexpr (kPaired) {
-    loaded_fields<M, V, kOnlyVelocities>(bodies, a, b, [&](const T* field, V& la, V& lb) COLLIDE_LANE_LAMBDA {
-      load_deinterleaved(field + at.a[0], la, lb);
-    });
+    load_paired<M, V, T, kOnlyVelocities>(bodies, at, a, b);
   } else if constexpr (kSoaLayout<View> && V::size() > 1 && !kOnlyVelocities) {
     load_streams_out_of_line<M, V, T>(bodies, at, a, b);
   } else if constexpr (kSoaLayout<View>) {
