@@ -170,6 +170,20 @@ def test_reference_and_impulse_error_match_check(cli, workdir):
     assert collide.impulse_error(bad, ref)[k] > 500
 
 
+@pytest.mark.parametrize("order", ["input", "colour"])
+@pytest.mark.parametrize("passes", [1, 4, 16])
+@pytest.mark.parametrize("kind,n,friction", [("pile", 12, False), ("pile", 12, True), ("debris", 20000, True)])
+def test_error_bound_can_fail_at_every_pass_count(kind, n, friction, order, passes):
+    # docs/python.md's assert, on the solve and on a J that is 1% too large
+    # or all zero (docs/collision-law.md, "The error bound over passes").
+    bodies, contacts = collide.generate(kind, n, friction=friction, seed=7)
+    ref = collide.reference_solve(bodies, contacts, order=order, passes=passes)
+    J, _ = collide.solve(bodies, contacts, order=order, passes=passes)
+    assert collide.impulse_error(J, ref).max() <= collide.error_bound_eps
+    assert collide.impulse_error(J * np.float32(1.01), ref).max() > collide.error_bound_eps
+    assert collide.impulse_error(np.zeros_like(J), ref).max() > collide.error_bound_eps
+
+
 def test_scene_round_trip(workdir):
     bodies, contacts = collide.generate("debris", 500, friction=True, dtype=np.float64)
     b_csv, c_csv = os.path.join(workdir, "b.csv"), os.path.join(workdir, "c.csv")

@@ -28,11 +28,12 @@ struct ReferenceContact {
   S jt = 0;   ///< friction impulse magnitude [N s]
   /// Sum of the magnitudes of the terms of u: |va| + |wa||ra| + |vb| + |wb||rb|
   /// [m/s], plus the velocity uncertainty the two bodies inherit from the
-  /// contacts applied to them before (Ev + Ew |r| per body; Ev grows by
-  /// s / m and Ew by s max(1/I) |r| with every contact on the body, s its
-  /// impulse_scale). The relative velocity is a difference of these terms, so
-  /// a kernel in precision eps cannot know u better than about eps *
-  /// speed_scale. For a body's first contact the inherited part is 0.
+  /// contacts applied to them before in the same pass (Ev + Ew |r| per body;
+  /// Ev grows by s / m and Ew by s max(1/I) |r| with every contact on the
+  /// body, s that contact's scale from its own speeds, without what it
+  /// inherited). The relative velocity is a difference of these terms, so a
+  /// kernel in precision eps cannot know u better than about eps *
+  /// speed_scale. For a body's first contact of a pass the inherited part is 0.
   S speed_scale = 0;
   /// The impulse scale that the error bound uses [N s]:
   ///   (1 + e) speed_scale / K(n)
@@ -62,7 +63,11 @@ struct SolveSequence {
 /// Applies the law to every contact in `sequence` (input order by default).
 /// Writes J into `impulses` and updates v, w of the bodies. `diagnostics`,
 /// when not null, receives one entry per contact: the last pass's, with the
-/// impulse scales of all passes added up (J is their sum).
+/// impulse scales of all passes added up (J is their sum), each pass's taken
+/// as of a one-pass solve from the velocities the pass before left, and,
+/// with several passes, widened where a replay of the sequence in the next
+/// shorter precision shows the passes amplifying rounding
+/// (docs/collision-law.md, "The error bound over passes").
 template <class S>
 void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, const ImpulseView<S>& impulses,
                      ReferenceContact<S>* diagnostics = nullptr, const SolveSequence& sequence = {});
