@@ -175,15 +175,14 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
                ReferenceContact<S>* diagnostics, const SolveSequence& sequence) {
   using V3 = Vec<S>;
   // The uncertainty each body's velocities inherit from the contacts applied
-  // to it before (linear [m/s] and angular [rad/s], in units of C eps): a
-  // kernel's impulse on a contact is off by up to C eps s (s its impulse
-  // scale), which moves the body by up to C eps s / m and, angularly,
-  // C eps s max(1/I) |r|; a later contact on that body sees its relative
-  // velocity off by that much on top of its own rounding. Carried forward to
-  // first order, this keeps the bound C eps s a statement about every
-  // contact of a chain, not only about the first one (without it, 1 contact
-  // in 100k of the debris scene, 6 deep in a chain, was 80 eps off in float,
-  // and the reference evaluated in double 57).
+  // to it before in the pass (linear [m/s] and angular [rad/s], in units of
+  // C eps): a kernel's impulse on a contact is off by up to C eps s (s the
+  // scale of its own rounding), which moves the body by up to C eps s / m
+  // and, angularly, C eps s max(1/I) |r|; a later contact on that body sees
+  // its relative velocity off by that much on top of its own rounding. This
+  // keeps the bound C eps s a statement about every contact of a chain, not
+  // only about the first one: without it, contacts deep in the debris
+  // scene's chains exceeded the bound (docs/decisions/0008).
   std::vector<S> inherited_v(kErrorAnalysis ? bodies.count : 0, S(0));
   std::vector<S> inherited_w(kErrorAnalysis ? bodies.count : 0, S(0));
   for (std::size_t step = 0; step < sequence.passes * contacts.count; ++step) {
@@ -304,11 +303,10 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
           // R^T (r x n) meets the largest inverse moment), not to the
           // possibly much smaller change it makes, and reaches u' times |r|:
           //   after_normal = s_n |W n| + jn sum_bodies max(1/I) |r|^2.
-          // Without it, a debris contact whose b side has a 47 m lever arm on
-          // a body with moments 1:62 measured 7.2 units in
-          // reference_solve<double>: the double state after the normal
-          // impulse was off by 14 eps of |u'| (docs/collision-law.md, "The
-          // friction step after the normal impulse").
+          // Without it, a debris contact with a long lever arm on a body of
+          // unequal moments exceeded the bound in reference_solve<double>
+          // (docs/collision-law.md, "The friction step after the normal
+          // impulse"; docs/decisions/0008).
           if constexpr (kErrorAnalysis) {
             const S own_after = own_speed_scale();
             auto with_friction = [&](S normal_scale, S before, S after) {
