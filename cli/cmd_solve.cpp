@@ -16,12 +16,14 @@
 //   the solve returns, nothing is written.
 // * kernel_seconds times Solver::solve alone (steady_clock), the number the
 //   project reports as throughput, less the ISA measurement that the first
-//   solve of a process runs with --isa auto (isa_calibration_seconds,
-//   reported apart by solve_record); reading, scheduling and writing are timed
+//   solve of a process runs with --isa auto (isa_calibration_seconds) and
+//   less the solver's allocate phase (allocate_seconds: the fresh Solver's
+//   buffers grown and their pages touched before its kernels run), both
+//   reported apart by solve_record; reading, scheduling and writing are timed
 //   separately, and io_seconds (read + write) with io_fraction (its share of
-//   read + schedule + kernel + write) say how much of a run is file I/O: for
-//   large scenes nearly all of it (2M bodies: seconds of CSV against
-//   milliseconds of kernel).
+//   read + schedule + solve + write, the solve's allocate phase included)
+//   say how much of a run is file I/O: for large scenes nearly all of it (2M
+//   bodies: seconds of CSV against milliseconds of kernel).
 // * --check runs reference_solve<long double> on an exact copy of the inputs
 //   taken before the solve (convert_* copy without renormalising), in the
 //   solve's sequence (its schedule's order, --passes times), and
@@ -108,9 +110,10 @@ const char* const kSolveUsage =
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
     "  --stats               print one JSON object of statistics on stderr (kernel,\n"
-    "                        schedule, read and write times; io_fraction is the\n"
-    "                        share of file I/O, nearly all of a large scene's time;\n"
-    "                        isa and isa_choice: forced, environment or measured)\n"
+    "                        allocate, schedule, read and write times; io_fraction\n"
+    "                        is the share of file I/O, nearly all of a large\n"
+    "                        scene's time; isa and isa_choice: forced, environment\n"
+    "                        or measured)\n"
     "  --check               also run the long double reference and compare the\n"
     "                        impulses; exit 3 if an error exceeds the documented bound\n"
     "\n"
@@ -238,8 +241,8 @@ int solve_scene(const SolveRequest& req) {
     // not the kernel, is where the time goes (docs/decisions/0011-csv-scene-files.md).
     const double io_seconds = read_seconds + write_seconds;
     record.emplace_back("io_seconds", io_seconds);
-    // Against the kernel time as reported: without the ISA calibration,
-    // which is reported apart (solve_record).
+    // Against the solve's time without the ISA calibration, which is
+    // reported apart (solve_record): the allocate phase is the solve's work.
     const double solve_seconds = schedule_seconds + std::max(0.0, kernel_seconds - stats.isa_calibration_seconds);
     record.emplace_back("io_fraction", io_seconds / (io_seconds + solve_seconds));
     if (req.check) add_check(record, check, check_seconds);

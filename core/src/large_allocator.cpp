@@ -3,6 +3,7 @@
 #include "collide/large_allocator.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <new>
 
@@ -11,8 +12,14 @@
 #endif
 
 namespace collide::detail {
+namespace {
+
+std::atomic<std::size_t> allocations{0};
+
+}  // namespace
 
 void* allocate_large(std::size_t bytes, std::size_t align) {
+  allocations.fetch_add(1, std::memory_order_relaxed);
   if (bytes < kHugePage) {
     const std::size_t rounded = (std::max<std::size_t>(bytes, 1) + align - 1) / align * align;
     void* p = align <= alignof(std::max_align_t) ? std::malloc(rounded) : std::aligned_alloc(align, rounded);
@@ -30,5 +37,7 @@ void* allocate_large(std::size_t bytes, std::size_t align) {
 }
 
 void free_large(void* p) noexcept { std::free(p); }
+
+std::size_t large_allocation_count() noexcept { return allocations.load(std::memory_order_relaxed); }
 
 }  // namespace collide::detail

@@ -1,11 +1,14 @@
 // prepared_contacts.cpp - the copies of prepared_contacts.hpp.
 #include "prepared_contacts.hpp"
 
-#include <numeric>
+#include <cassert>
+#include <cstdint>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/partitioner.h>
+
+#include "first_touch.hpp"
 
 namespace collide::detail {
 namespace {
@@ -31,31 +34,54 @@ void gather(V* to, const V* from, const std::uint32_t* order, std::size_t begin,
   for (std::size_t i = begin; i < end; ++i) to[i] = from[order[i]];
 }
 
+/// Whether the contact point is given (the model reads it): a particle
+/// solve may have none.
+template <class T>
+bool has_point(const ContactView<T>& contacts) {
+  return contacts.c.x != nullptr && contacts.c.y != nullptr && contacts.c.z != nullptr;
+}
+
 }  // namespace
+
+template <class T>
+bool PreparedContacts<T>::allocate(tbb::task_arena& arena, const KernelJob<T>& job, bool geometry) {
+  const ContactView<T>& contacts = job.contacts;
+  const std::size_t n = contacts.count;
+  // Sized to n: a smaller solve after a larger one neither allocates nor
+  // touches new pages; an array that grows is replaced by room for n.
+  FirstTouch touch;
+  bool grew = touch.resize(a_, n);
+  grew |= touch.resize(b_, n);
+  for (int k = 0; k < 3; ++k) {
+    if (has_point(contacts)) grew |= touch.resize(c_[k], n);
+    grew |= touch.resize(n_[k], n);
+    grew |= touch.resize(j_[k], n);
+  }
+  if (contacts.e != nullptr) grew |= touch.resize(e_, n);
+  if (contacts.mu != nullptr) grew |= touch.resize(mu_, n);
+  if (geometry) {
+    for (ScratchVector<T>& values : geometry_) grew |= touch.resize(values, n);
+  }
+  touch.run(arena);
+  // The identity order: written once, for the whole storage, when it grows
+  // (those writes touch its pages); a smaller size keeps the values.
+  if (resize_scratch(identity_, n)) {
+    grew = true;
+    std::uint32_t* const identity = identity_.data();
+    for_parts(arena, n, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) identity[i] = static_cast<std::uint32_t>(i);
+    });
+  }
+  return grew;
+}
 
 template <class T>
 KernelJob<T> PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form) {
   const ContactView<T>& contacts = job.contacts;
   const std::uint32_t* order = job.order;
   const std::size_t n = contacts.count;
-  // The point only where the model reads it: a particle solve may have none.
-  const bool point = contacts.c.x != nullptr && contacts.c.y != nullptr && contacts.c.z != nullptr;
-  // Sized to n: a ScratchVector keeps its capacity, and a smaller solve
-  // after a larger one neither allocates nor touches new pages.
-  a_.resize(n);
-  b_.resize(n);
-  for (int k = 0; k < 3; ++k) {
-    if (point) c_[k].resize(n);
-    n_[k].resize(n);
-    j_[k].resize(n);
-  }
-  if (contacts.e != nullptr) e_.resize(n);
-  if (contacts.mu != nullptr) mu_.resize(n);
-  if (identity_.size() < n) {
-    const std::size_t from = identity_.size();
-    identity_.resize(n);
-    std::iota(identity_.begin() + static_cast<std::ptrdiff_t>(from), identity_.end(), static_cast<std::uint32_t>(from));
-  }
+  const bool point = has_point(contacts);
+  assert(a_.size() == n && identity_.size() == n && (form == nullptr || geometry_[0].size() == n));
 
   ContactView<T> v;
   v.count = n;
@@ -75,7 +101,6 @@ KernelJob<T> PreparedContacts<T>::prepare(tbb::task_arena& arena, const KernelJo
   on_prepared.stepped = form != nullptr;
   on_prepared.geometry = {};
   if (form != nullptr) {
-    for (ScratchVector<T>& values : geometry_) values.resize(n);
     GeometryView<T>& g = on_prepared.geometry;
     for (std::size_t k = 0; k < 3; ++k) {
       g.ra[k] = geometry_[k].data();

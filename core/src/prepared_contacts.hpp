@@ -20,6 +20,9 @@
 //   most 56 bytes a contact; the arrays grow to the largest solve and are
 //   kept, and each is written in full by the prepare before anything reads
 //   it (ScratchVector leaves new elements uninitialised).
+// * When: allocate() sizes the arrays and touches the pages of those that
+//   grew, on the solve's threads, before the solve's kernels run (the
+//   Solver's allocate phase, first_touch.hpp); prepare() then only copies.
 // * With several passes (fast mode, frictionless), the velocity-free half of
 //   the law of every contact (GeometryView: offsets, lever arms, K terms,
 //   inverse masses; 64 bytes a contact in float) is formed by the prepare,
@@ -48,13 +51,20 @@ namespace collide::detail {
 template <class T>
 class PreparedContacts {
  public:
+  /// Sizes the arrays a prepare of `job` uses to its contact count (with
+  /// `geometry`, those of the velocity-free half too) and touches the pages
+  /// of every array that had to grow, on the threads of `arena`; writes the
+  /// identity order when it grew. Returns whether anything grew: nothing is
+  /// allocated when the count is within every count before.
+  bool allocate(tbb::task_arena& arena, const KernelJob<T>& job, bool geometry);
+
   /// Copies the job's contacts order[0], order[1], ... (contacts.count of
   /// them) into the prepared arrays, on the threads of `arena`; with `form`
   /// (the run geometry kernel of the solve's ISA), forms their geometry too,
   /// from the job's bodies. Returns the job on the prepared arrays: their
   /// contacts and J, the identity order, and with `form` the geometry
-  /// (KernelJob::stepped). Allocates only when the count exceeds every
-  /// count before.
+  /// (KernelJob::stepped). allocate() must have sized the arrays for the
+  /// job (with geometry when `form` is given); nothing is allocated here.
   KernelJob<T> prepare(tbb::task_arena& arena, const KernelJob<T>& job, RunGeometryKernel<T> form = nullptr);
 
   /// J of position i to impulses[order[i]], for every prepared contact.

@@ -7,12 +7,15 @@
 // (perf, `collide solve` on 2M debris). So the storage is left
 // uninitialised (pack() writes every record before the kernel reads it) and
 // in huge pages (collide/large_allocator.hpp): 2 MiB pages fault 512 times less
-// often and cost fewer TLB misses on random access.
+// often and cost fewer TLB misses on random access. New storage is first
+// touched by the solver's allocate phase (first_touch.hpp), on every thread,
+// before packing starts.
 #pragma once
 
 #include <cstddef>
 
 #include "collide/large_allocator.hpp"
+#include "first_touch.hpp"
 
 namespace collide::detail {
 
@@ -25,13 +28,15 @@ class ScratchRecords {
   ~ScratchRecords() { free_large(data_); }
 
   /// Storage for n records (contents unspecified); allocates only when n is
-  /// more than any n before.
-  Record* reserve(std::size_t n) {
+  /// more than any n before, and then adds the new storage to `touch`.
+  Record* reserve(std::size_t n, FirstTouch& touch) {
     if (n <= capacity_) return data_;
-    Record* p = allocate_large_array<Record>(n);
-    free_large(data_);
-    data_ = p;
+    free_large(data_);  // first: its records are not kept, and the peak is lower
+    data_ = nullptr;
+    capacity_ = 0;
+    data_ = allocate_large_array<Record>(n);
     capacity_ = n;
+    touch.add(data_, n * sizeof(Record));
     return data_;
   }
 

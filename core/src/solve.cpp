@@ -18,7 +18,14 @@
 // * Nothing here allocates once the packing and prepared buffers are sized: the Solver owns
 //   its task_arena (or borrows the caller's, collide/tbb.hpp), the Schedule
 //   owns the order.
+// * The allocate phase: a solve sizes the buffers it uses (the packed
+//   records, the prepared contacts) before it packs or copies anything, and
+//   has the pages of what grew touched by the arena's threads
+//   (first_touch.hpp), so the faults of a fresh Solver's first solve are
+//   paid there, timed as SolveStats::allocate_seconds, and not by the passes
+//   that follow. A solve that finds its buffers sized reports 0.
 #include <cassert>
+#include <chrono>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -30,6 +37,7 @@
 #include "collide/solve.hpp"
 #include "collide/tbb.hpp"
 #include "collide/validate.hpp"
+#include "first_touch.hpp"
 #include "kernel_table.hpp"
 #include "prepared_contacts.hpp"
 #include "run_schedule.hpp"
@@ -112,12 +120,19 @@ struct Solver::Impl {
 
   /// Runs the job's contacts over the schedule with the picked kernels: on
   /// the caller's contacts, or on contacts prepared in the schedule's order
-  /// (detail::prepares_contacts).
+  /// (detail::prepares_contacts). `allocate_seconds` is what the solve's
+  /// allocate phase took before (the packing buffer's); the prepared
+  /// contacts' is added.
   template <class T>
-  SolveStats run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule);
+  SolveStats run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule,
+                 double allocate_seconds);
 };
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 /// The options a Solver refuses, before it starts its threads.
 void check_options(const SolverOptions& options) {
@@ -149,7 +164,8 @@ Solver& Solver::operator=(Solver&&) noexcept = default;
 const SolverOptions& Solver::options() const { return impl_->options; }
 
 template <class T>
-SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule) {
+SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJob<T>& job, const Schedule& schedule,
+                             double allocate_seconds) {
   const detail::KernelTable& table = *pick.kernels;
   detail::WalkPlan plan;
   plan.simd = options.path == Path::simd;
@@ -164,6 +180,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const std::lock_guard<std::mutex> lock(prepare_mutex);
     detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
+    const auto t_allocate = Clock::now();
+    if (prepared_contacts.allocate(*arena, job, stepped)) allocate_seconds += seconds_since(t_allocate);
     const detail::KernelJob<T> on_prepared = prepared_contacts.prepare(
         *arena, job, stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
     plan.prepared = true;
@@ -187,6 +205,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.isa = plan.simd ? table.isa : Isa::sse2;
   stats.isa_choice = pick.choice;
   stats.isa_calibration_seconds = pick.calibration_seconds;
+  stats.allocate_seconds = allocate_seconds;
   stats.layout = job.packed ? BodyLayout::packed : BodyLayout::soa;
   stats.accuracy = options.accuracy;
   stats.order = schedule.ordering();
@@ -332,18 +351,27 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
                                                    schedule.contact_count());
   if (!detail::should_pack(impl_->options.layout, scattered, bodies.count)) {
     detail::set_view(job, bodies);
-    return impl_->run(pick, job, schedule);
+    return impl_->run(pick, job, schedule, 0.0);
   }
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
   PackedView<Record> packed;
   packed.count = bodies.count;
-  packed.bodies = impl_->buffer<Record>().reserve(bodies.count);
+  double allocate_seconds = 0;
+  {
+    const auto t_allocate = Clock::now();
+    detail::FirstTouch touch;
+    packed.bodies = impl_->buffer<Record>().reserve(bodies.count, touch);
+    if (!touch.empty()) {
+      touch.run(*impl_->arena);
+      allocate_seconds = seconds_since(t_allocate);
+    }
+  }
   // A rigid view's inverse masses are the caller's own array: the kernels
   // only read them, so they are not copied.
   if constexpr (std::is_same_v<Record, PackedRigid<T>>) packed.inv_mass = bodies.inv_mass;
   impl_->arena->execute([&] { pack(bodies, packed); });
   detail::set_view(job, packed);
-  SolveStats stats = impl_->run(pick, job, schedule);
+  SolveStats stats = impl_->run(pick, job, schedule, allocate_seconds);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
   return stats;
 }
@@ -360,7 +388,7 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   // The caller's records are solved in place: no packing buffer of the
   // solver's is used, so solves on one Solver may run at once, as on SoA
   // views (colour-order ones take turns over the prepared contacts).
-  return impl_->run(pick, job, schedule);
+  return impl_->run(pick, job, schedule, 0.0);
 }
 
 template <class T>

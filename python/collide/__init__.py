@@ -77,7 +77,13 @@ __version__ = "0.1.0"
 class Stats(dict):
     """The statistics of a solve, as :func:`solve` and :meth:`Solver.solve`
     return them: a dict with the keys of ``collide solve --stats``, shown one
-    key per line."""
+    key per line. Its times: ``kernel_seconds`` (the solve, less the two
+    below), ``isa_calibration_seconds`` (the ISA measurement of the first
+    solve of a kind in the process), ``allocate_seconds`` (growing the
+    solver's buffers and touching their pages before the kernels run: the
+    first solve of a size on a Solver, every one-shot :func:`solve`; 0 when
+    they were sized) and ``schedule_seconds`` (the schedule the call built,
+    0 for one given)."""
 
     __slots__ = ()
 
@@ -94,7 +100,10 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     of ``collide solve --stats`` (collisions, impacts, bodies, kernel_seconds,
     collisions_per_second, precision, threads, model, path, isa, isa_choice,
     layout, accuracy, lanes, order, passes, batches, largest_batch, colours,
-    overflow_contacts, schedule_seconds, isa_calibration_seconds). ``model`` is "auto" (the
+    overflow_contacts, schedule_seconds, isa_calibration_seconds,
+    allocate_seconds; kernel_seconds is the solve less its ISA measurement
+    and its allocate phase, the one-time growth of the solver's buffers,
+    each reported on its own). ``model`` is "auto" (the
     cheapest that fits), "rigid", "sphere" or "particle"; ``path`` "simd" or
     "scalar"; ``threads`` 0 for all; ``isa`` None (automatic: COLLIDE_ISA,
     else the fastest on this CPU, measured once per process), "sse2", "avx2"

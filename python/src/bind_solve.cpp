@@ -20,7 +20,9 @@
 //   reference). The ndarrays stay referenced by the Bodies and Contacts
 //   objects (and the call's arguments) meanwhile.
 // * The statistics dict is collide::solve_record (collide/eval/check.hpp),
-//   the record `collide solve --stats` prints, the error per contact is
+//   the record `collide solve --stats` prints (kernel_seconds is the wall
+//   time of the solve call below less the solve's ISA measurement and its
+//   allocate phase, which have keys of their own), the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises, and the
 //   conservation drifts are collide::conservation_drift, the report's.
 #include <pybind11/numpy.h>

@@ -458,9 +458,10 @@ TEST_F(CliTest, StatsIsOneJsonObjectWithTheDocumentedFields) {
   EXPECT_EQ(r.err.front(), '{');
   EXPECT_EQ(r.err.substr(r.err.size() - 2), "}\n");
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
-  for (const char* field : {"\"collisions\": 4", "\"kernel_seconds\"", "\"collisions_per_second\"",
-                            "\"precision\": \"float\"", "\"threads\"", "\"model\": \"rigid\"", "\"path\": \"scalar\"",
-                            "\"lanes\": 1", "\"batches\"", "\"schedule_seconds\"", "\"isa_choice\": \"baseline\""}) {
+  for (const char* field :
+       {"\"collisions\": 4", "\"kernel_seconds\"", "\"collisions_per_second\"", "\"precision\": \"float\"",
+        "\"threads\"", "\"model\": \"rigid\"", "\"path\": \"scalar\"", "\"lanes\": 1", "\"batches\"",
+        "\"schedule_seconds\"", "\"isa_choice\": \"baseline\"", "\"allocate_seconds\""}) {
     EXPECT_NE(r.err.find(field), std::string::npos) << field << " missing in " << r.err;
   }
   EXPECT_EQ(r.err.find("check"), std::string::npos) << "no check fields without --check";
@@ -480,13 +481,36 @@ TEST_F(CliTest, StatsSaysHowMuchIsFileIo) {
   const double write = stats_number(r.err, "write_seconds");
   const double io = stats_number(r.err, "io_seconds");
   const double fraction = stats_number(r.err, "io_fraction");
-  const double rest = stats_number(r.err, "schedule_seconds") + stats_number(r.err, "kernel_seconds");
+  // The solve: its schedule, its allocate phase and its kernels.
+  const double rest = stats_number(r.err, "schedule_seconds") + stats_number(r.err, "allocate_seconds") +
+                      stats_number(r.err, "kernel_seconds");
   ASSERT_TRUE(std::isfinite(io)) << r.err;
   // Printed with 9 significant digits: equal to that precision.
   EXPECT_NEAR(io, read + write, 1e-8 * io + 1e-12) << r.err;
   EXPECT_NEAR(fraction, io / (io + rest), 1e-6) << r.err;
   EXPECT_GT(fraction, 0);
   EXPECT_LE(fraction, 1);
+}
+
+TEST_F(CliTest, StatsReportsTheAllocatePhaseApartFromTheKernel) {
+  // A pile in the colour order: the solve copies its contacts into the
+  // solver's arrays, which a one-shot solve allocates and touches first.
+  ASSERT_EQ(run({"gen", "--pile", "20", "--out", dir_.string()}).exit_code, 0);
+  for (const char* order : {"input", "colour"}) {
+    const RunResult r = run({"solve", "--bodies", path("bodies.csv").string(), "--contacts",
+                             path("contacts.csv").string(), "--out-bodies", path("ob.csv").string(), "--out-impulses",
+                             path("oj.csv").string(), "--order", order, "--stats"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const double allocate = stats_number(r.err, "allocate_seconds");
+    const double kernel = stats_number(r.err, "kernel_seconds");
+    EXPECT_TRUE(std::isfinite(allocate)) << r.err;
+    EXPECT_GE(allocate, 0) << r.err;
+    EXPECT_TRUE(std::isfinite(kernel)) << r.err;
+    EXPECT_GE(kernel, 0) << r.err;
+    if (std::string(order) == "colour") {
+      EXPECT_GT(allocate, 0) << r.err;
+    }
+  }
 }
 
 TEST_F(CliTest, StatsReportsCheck) {

@@ -115,7 +115,8 @@ TEST(Check, ImpactsAndRecord) {
                                              "colours",
                                              "overflow_contacts",
                                              "schedule_seconds",
-                                             "isa_calibration_seconds"};
+                                             "isa_calibration_seconds",
+                                             "allocate_seconds"};
   EXPECT_EQ(keys, expected);
   add_check(r, ImpulseCheck{}, 0.25);
   const std::string json = to_json(r);
@@ -139,6 +140,18 @@ TEST(Check, ImpactsAndRecord) {
   EXPECT_EQ(std::get<double>(value("kernel_seconds")), 0.75);
   EXPECT_EQ(std::get<double>(value("isa_calibration_seconds")), 0.25);
   EXPECT_EQ(std::get<std::string>(value("isa_choice")), "measured");
+
+  // So does one that grew its buffers (the allocate phase).
+  st.allocate_seconds = 0.125;
+  const StatRecord a = solve_record<double>(st, std::as_const(j).view(), 8, 1.0, 0.5);
+  const auto of_a = [&](const char* key) {
+    for (const auto& [k, v] : a) {
+      if (k == key) return v;
+    }
+    return StatValue{};
+  };
+  EXPECT_EQ(std::get<double>(of_a("kernel_seconds")), 0.625);
+  EXPECT_EQ(std::get<double>(of_a("allocate_seconds")), 0.125);
 }
 
 TEST(ValidateIndices, NamesTheFirstBadIndex) {

@@ -112,6 +112,8 @@ def test_arrays_same_bytes_as_collide_solve(client, model, dtype, accuracy):
     assert solution.v is bodies.v and solution.w is bodies.w, "the caller's arrays, updated in place"
     assert solution.stats["model"] == model and solution.stats["accuracy"] == accuracy
     assert len(solution.stats["partitions"]) == 2 and sum(solution.stats["partitions"]) == len(contacts)
+    for key in ("kernel_seconds", "allocate_seconds"):  # the partitions' solves, summed
+        assert np.isfinite(solution.stats[key]) and solution.stats[key] >= 0, (key, solution.stats)
 
 
 def test_grouping_and_forced_model_do_not_change_the_bytes(client):

@@ -225,6 +225,25 @@ def test_readable_reprs():
     assert eval(text, {"Stats": collide.Stats}) == stats
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_allocate_seconds_apart_from_the_kernel(dtype):
+    # A one-shot solve of a pile in the colour order allocates the solver's
+    # copy of the contacts first: its allocate phase, reported on its own.
+    bodies, contacts = collide.generate("pile", 20, dtype=dtype)
+    _, stats = collide.solve(bodies, contacts, order="colour")
+    for key in ("allocate_seconds", "kernel_seconds", "isa_calibration_seconds"):
+        assert isinstance(stats[key], float) and np.isfinite(stats[key]) and stats[key] >= 0, (key, stats)
+    assert stats["allocate_seconds"] > 0, stats
+    assert "'allocate_seconds': " in repr(stats)
+    # A reused solver finds its buffers sized: nothing to allocate.
+    solver = collide.Solver(order="colour")
+    schedule = collide.Schedule(bodies, contacts, order="colour")
+    _, first = solver.solve(bodies, contacts, schedule=schedule)
+    _, second = solver.solve(bodies, contacts, schedule=schedule)
+    assert first["allocate_seconds"] > 0, first
+    assert second["allocate_seconds"] == 0.0, second
+
+
 def test_report_quick_rows():
     rows = collide.report(n=2000, sample=500, runs=1, threads=[1], quick=True)
     assert rows and {"scene", "variant", "model", "precision", "max_err_eps", "collisions_per_second"} <= set(rows[0])

@@ -31,6 +31,10 @@ inline constexpr std::size_t kHugePage = std::size_t{2} << 20;
 [[nodiscard]] void* allocate_large(std::size_t bytes, std::size_t align);
 void free_large(void* p) noexcept;
 
+/// Calls of allocate_large so far in this process, from every thread (what
+/// the tests count to show that a reused Solver allocates nothing).
+std::size_t large_allocation_count() noexcept;
+
 /// allocate_large for n values of T (std::bad_array_new_length if n *
 /// sizeof(T) overflows).
 template <class T>

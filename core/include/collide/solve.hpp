@@ -103,6 +103,15 @@ struct SolveStats {
   /// first solve of its kind in the process with isa_choice measured pays
   /// about a millisecond, every later one 0. Part of the solve's wall time.
   double isa_calibration_seconds = 0;
+  /// Time this solve spent in its allocate phase [s]: growing the solver's
+  /// buffers (the records SoA input is packed into, the contacts a colour-
+  /// order solve copies into its order) and writing a byte in every new page
+  /// on the solve's threads, so that the passes that follow pay no first-
+  /// touch page faults. The first solve of a size on a Solver (every one-shot
+  /// collide::solve) pays it; a solve whose buffers are already large enough
+  /// allocates nothing and reports 0. Part of the solve's wall time, before
+  /// any kernel runs.
+  double allocate_seconds = 0;
   BodyLayout layout = BodyLayout::soa;  ///< the layout the kernel ran on (never automatic)
   Accuracy accuracy = Accuracy::fast;
   Order order = Order::input;         ///< the schedule's order
@@ -161,6 +170,8 @@ struct ExternalArena;
 /// A reusable solver. It owns the worker threads (a tbb::task_arena), or runs
 /// in the caller's arena (collide/tbb.hpp), and allocates nothing while
 /// solving once its buffers are sized, so one Solver can run every frame.
+/// A solve that has to grow them does so first, and touches their new pages
+/// on its threads before its kernels run (SolveStats::allocate_seconds).
 ///
 /// SoA input whose contacts reach bodies at random (contacts in
 /// non-contiguous batches, or in consecutive batches whose bodies do not

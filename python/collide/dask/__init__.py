@@ -251,8 +251,11 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     islands, largest_island, largest_island_share, partitions (their contact
     counts), model, precision, accuracy, seconds (the whole call),
     collisions_per_second (collisions / seconds), islands_seconds,
-    kernel_seconds (the partitions' solves, summed), partition_seconds
-    (each partition's task on its worker, read to write), and for files
+    kernel_seconds (the partitions' solves, summed), allocate_seconds (the
+    allocate phases of those solves, summed: each task's one-shot solver
+    grows its buffers and touches their pages before its kernels run, time
+    kernel_seconds leaves out), partition_seconds (each partition's task on
+    its worker, read to write), and for files
     read_seconds (the load and check on the client)."""
     started = time.perf_counter()
     options = _options(model, accuracy, threads, isa)
@@ -283,6 +286,7 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
             "accuracy": options["accuracy"], "seconds": seconds,
             "collisions_per_second": collisions / seconds if seconds > 0 else 0.0,
             "kernel_seconds": sum(r["kernel_seconds"] for r in results),
+            "allocate_seconds": sum(r["allocate_seconds"] for r in results),
             "partition_seconds": [r["seconds"] for r in results], **extra}
 
 

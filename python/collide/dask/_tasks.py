@@ -98,6 +98,7 @@ def _solve(bodies, contacts, options):
 
 def _part_stats(stats, contacts, bodies, started, read_seconds):
     return {"contacts": contacts, "bodies": bodies, "kernel_seconds": stats["kernel_seconds"],
+            "allocate_seconds": stats["allocate_seconds"],
             "schedule_seconds": stats["schedule_seconds"], "batches": stats["batches"], "isa": stats["isa"],
             "read_seconds": read_seconds, "seconds": time.perf_counter() - started}
 

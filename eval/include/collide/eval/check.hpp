@@ -64,9 +64,11 @@ using StatRecord = std::vector<std::pair<std::string, StatValue>>;
 /// The record of one solve: collisions, impacts, bodies, kernel_seconds,
 /// collisions_per_second, precision, threads, model, path, isa, isa_choice,
 /// layout, accuracy, lanes, order, passes, batches, largest_batch, colours,
-/// overflow_contacts, schedule_seconds, isa_calibration_seconds. `kernel_seconds` is the wall time of the solve
-/// call; the ISA measurement it may contain (SolveStats::
-/// isa_calibration_seconds) is taken out of it and reported on its own.
+/// overflow_contacts, schedule_seconds, isa_calibration_seconds,
+/// allocate_seconds. `kernel_seconds` is the wall time of the solve call
+/// given here, less what it may contain that is not the solve's work: the
+/// ISA measurement (SolveStats::isa_calibration_seconds) and the allocate
+/// phase (SolveStats::allocate_seconds), each reported on its own.
 template <class T>
 StatRecord solve_record(const SolveStats& stats, const ImpulseView<const T>& impulses, std::size_t bodies,
                         double kernel_seconds, double schedule_seconds);
