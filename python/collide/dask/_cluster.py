@@ -71,7 +71,9 @@ def main():
     """The cluster process (see the module's notes): serves until stdin closes."""
     import distributed
 
+    # No dashboard; the scheduler's HTTP server (health, metrics) on a free
+    # port, not on 8787, which another cluster may hold (Dask then warns).
     with distributed.LocalCluster(n_workers=int(sys.argv[1]), threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
+                                  dashboard_address=None, scheduler_kwargs={"dashboard_address": ":0"}) as cluster:
         print(cluster.scheduler_address, flush=True)
         sys.stdin.read()  # until the caller closes it
