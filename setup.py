@@ -54,6 +54,10 @@ class CMakeBuild(build_ext):
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(built, target)
+        # The interpreter the extension is for (python/collide/_build.py.in),
+        # which `import collide` names when it cannot run.
+        shutil.copyfile(os.path.join(os.path.dirname(built), "_build.py"),
+                        os.path.join(os.path.dirname(target), "_build.py"))
 
 
 setup(ext_modules=[CMakeExtension("collide._collide")], cmdclass={"build_ext": CMakeBuild})

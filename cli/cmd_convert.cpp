@@ -23,19 +23,17 @@
 //   32-bit, a != b); whether they are below the body count is checked when
 //   the scene is solved.
 // * The output goes through OutputFile: nothing is written on bad input.
-//   Its directory is created, as `collide gen` creates its own, once the
-//   input has been read.
+//   Its directory is created when missing (OutputFile, as for every
+//   output), once the input has been read.
 #include <algorithm>
 #include <atomic>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -216,21 +214,9 @@ bool written_from_floats(const Input<double>& d, const Input<float>& f) {
   return all.load() && any_long.load();
 }
 
-/// Creates the directory of `path` if it has one and it is missing, as
-/// `collide gen` creates its output directory. Not for '-'.
-void create_parent_directory(const std::string& path) {
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  if (path == "-" || dir.empty()) return;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir)) {
-    throw SceneError(dir.string(), "cannot create directory: " + (ec ? ec.message() : std::string("not a directory")));
-  }
-}
-
+/// The output, its directory created if missing (OutputFile).
 template <class T>
 void write(const Input<T>& input, const std::string& out_path, SceneFormat out_format) {
-  create_parent_directory(out_path);
   OutputFile out(out_path);
   input.write(out, out_format);
   out.commit();

@@ -17,13 +17,11 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
 #include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 
 #include "collide/io/drawn_scene.hpp"
@@ -42,7 +40,9 @@ const char* const kGenUsage =
     "\n"
     "Writes a random scene as DIR/bodies.csv and DIR/contacts.csv, or with\n"
     "--format npz as the binary DIR/bodies.npz and DIR/contacts.npz (DIR is created\n"
-    "if needed). The same seed gives the same bytes.\n"
+    "if needed). The same seed gives the same bytes. Every count starts at 1 and\n"
+    "ends where 32-bit body ids do: N up to 2147483647 pairs, 4294967295 debris\n"
+    "contacts or 4294967294 chain contacts, S up to 1625.\n"
     "\n"
     "  --pairs N      N independent approaching pairs: contact k joins bodies 2k, 2k+1\n"
     "  --debris N     N contacts over N/2 movable bodies that share contacts, plus an\n"
@@ -172,15 +172,9 @@ int run_gen(int argc, char** argv) {
     throw UsageError("give exactly one of --pairs N, --debris N, --pile S and --chain N");
   }
   const char* const kind = pairs ? "pairs" : debris ? "debris" : pile ? "pile" : "chain";
-  const unsigned long long n = parse_count(kind, opt.at(kind));
-  // Body ids are 32-bit (contacts.hpp): 2N bodies for pairs, N/2 + 1 for
-  // debris, S^3 + 1 for a pile.
-  if (pile && n > kMaxPileSide) {
-    throw UsageError("--pile " + opt.at("pile") + " is too large: at most " + std::to_string(kMaxPileSide) +
-                     " boxes per side (body ids are 32-bit)");
-  }
-  const unsigned long long max_n = pairs ? 0x7FFFFFFFULL : chain ? kMaxChainContacts : 0xFFFFFFFFULL;
-  if (n > max_n) throw UsageError("scene too large: body ids are 32-bit");
+  // From 1 (no scene is empty) to what 32-bit body ids allow: the range
+  // collide.generate takes too (max_scene_count).
+  const unsigned long long n = parse_integer(kind, opt.at(kind), 1, max_scene_count(kind));
   if (opt.count("shuffle") != 0 && !pile) {
     throw UsageError("--shuffle is for --pile (the pairs, debris and chain contacts have no cell order to shuffle)");
   }
@@ -211,13 +205,7 @@ int run_gen(int argc, char** argv) {
   const bool want_float = precision == Precision::single;
   const ThreadLimit limit(parse_threads(opt));
 
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec || !std::filesystem::is_directory(dir)) {
-    std::fprintf(stderr, "collide: cannot create directory '%s': %s\n", dir.c_str(),
-                 ec ? ec.message().c_str() : "not a directory");
-    return kExitBadInput;
-  }
+  // OutputFile creates DIR (and its parents) when missing.
   const std::string suffix = format == SceneFormat::npz ? ".npz" : ".csv";
   OutputFile bodies(dir + "/bodies" + suffix);
   OutputFile contacts(dir + "/contacts" + suffix);

@@ -10,7 +10,9 @@
 
 #include "collide/eval/check.hpp"
 #include "collide/eval/error_bound.hpp"
+#include "collide/io/generate.hpp"
 #include "collide/io/scene_io.hpp"
+#include "collide/solve.hpp"
 #include "commands.hpp"
 #include "report.hpp"
 
@@ -70,8 +72,7 @@ std::vector<int> parse_thread_list(const std::string& text) {
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    const unsigned long long t = parse_count("threads", item);
-    if (t == 0 || t > 4096) throw UsageError("--threads needs counts from 1 to 4096, got '" + item + "'");
+    const unsigned long long t = parse_integer("threads", item, 1, kMaxThreads);
     if (std::find(threads.begin(), threads.end(), static_cast<int>(t)) == threads.end()) {
       threads.push_back(static_cast<int>(t));
     }
@@ -117,40 +118,31 @@ int run_report(int argc, char** argv) {
   std::string json_path, plot_path;
   config.quick = opt.count("quick") != 0;
   if (config.quick) config.runs = 3;
-  if (const auto it = opt.find("n"); it != opt.end()) config.n = parse_count("n", it->second);
   // Pairs use 2n body ids, which are 32-bit.
-  if (config.n < 1 || config.n > 0x7FFFFFFFULL) throw UsageError("--n must be from 1 to 2^31 - 1");
+  if (const auto it = opt.find("n"); it != opt.end()) config.n = parse_integer("n", it->second, 1, kMaxPairs);
   if (const auto it = opt.find("threads"); it != opt.end()) config.threads = parse_thread_list(it->second);
   if (const auto it = opt.find("json"); it != opt.end()) json_path = it->second;
   if (const auto it = opt.find("plot"); it != opt.end()) plot_path = it->second;
   if (const auto it = opt.find("sample"); it != opt.end()) {
-    config.sample = parse_count("sample", it->second);
-    if (config.sample < 1 || config.sample > 0x7FFFFFFFULL) throw UsageError("--sample must be from 1 to 2^31 - 1");
+    config.sample = parse_integer("sample", it->second, 1, 0x7FFFFFFF);
   }
   if (const auto it = opt.find("runs"); it != opt.end()) {
-    const unsigned long long runs = parse_count("runs", it->second);
-    if (runs < 1 || runs > 1000) throw UsageError("--runs must be from 1 to 1000");
-    config.runs = static_cast<int>(runs);
+    config.runs = static_cast<int>(parse_integer("runs", it->second, 1, 1000));
   }
   if (const auto it = opt.find("seed"); it != opt.end()) config.seed = parse_count("seed", it->second);
   if (const auto it = opt.find("debris-n"); it != opt.end()) {
-    config.debris_n = parse_count("debris-n", it->second);
-    if (config.debris_n < 1 || config.debris_n > 0xFFFFFFFFULL) {
-      throw UsageError("--debris-n must be from 1 to 2^32 - 1");
-    }
+    config.debris_n = parse_integer("debris-n", it->second, 1, kMaxDebrisContacts);
   } else {
     config.debris_n = std::min(config.n, config.debris_n);
   }
   if (const auto it = opt.find("pile-n"); it != opt.end()) {
-    config.pile_n = parse_count("pile-n", it->second);
-    if (config.pile_n < 1 || config.pile_n > 0xFFFFFFFFULL) throw UsageError("--pile-n must be from 1 to 2^32 - 1");
+    config.pile_n = parse_integer("pile-n", it->second, 1, 0xFFFFFFFF);
   } else {
     config.pile_n = std::min(config.n, config.pile_n);
   }
   config.hard = opt.count("hard") != 0 || opt.count("hard-n") != 0;
   if (const auto it = opt.find("hard-n"); it != opt.end()) {
-    config.hard_n = parse_count("hard-n", it->second);
-    if (config.hard_n < 1 || config.hard_n > 0x7FFFFFFFULL) throw UsageError("--hard-n must be from 1 to 2^31 - 1");
+    config.hard_n = parse_integer("hard-n", it->second, 1, kMaxPairs);
   }
   if (opt.count("bodies") != opt.count("contacts")) throw UsageError("--bodies and --contacts go together");
   if (opt.count("bodies") != 0) {

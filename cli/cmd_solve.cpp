@@ -35,7 +35,9 @@
 //   --format says (collide/io/scene_npz.hpp). A binary input is mapped and its
 //   columns used in place; without --precision a binary scene is solved in
 //   its own precision (converting it would cost what mapping saves), a CSV
-//   one in double.
+//   one in double, and binary bodies and contacts files of different
+//   precisions are a usage error that asks for --precision (neither file's
+//   precision is more the scene's than the other's).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -43,6 +45,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -77,15 +80,17 @@ const char* const kSolveUsage =
     "  --bodies FILE         bodies.csv: m,Ix,Iy,Iz,qw,qx,qy,qz,px,py,pz,vx,vy,vz,wx,wy,wz\n"
     "  --contacts FILE       contacts.csv: a,b,cx,cy,cz,nx,ny,nz,e,mu\n"
     "  --out-bodies FILE     result bodies file: a regular file is replaced\n"
-    "                        atomically; '-' (stdout), a device such as /dev/null\n"
-    "                        or a FIFO is written in place\n"
+    "                        atomically (its directory created if missing); '-'\n"
+    "                        (stdout), a device such as /dev/null or a FIFO is\n"
+    "                        written in place\n"
     "  --out-impulses FILE   result impulses file, likewise (only one output may be '-')\n"
     "  --format F            csv or npz for all four files above, the inputs too\n"
     "                        (default: each file by its name: npz, the binary scene\n"
     "                        format, for a name ending in .npz, else csv; so CSV\n"
     "                        inputs and binary outputs need only the .npz names)\n"
-    "  --precision P         float or double (default: a binary scene's own, else\n"
-    "                        double)\n"
+    "  --precision P         float or double (default: a binary bodies file's own,\n"
+    "                        else double; binary bodies and contacts files of\n"
+    "                        different precisions need it)\n"
     "  --threads N           worker threads, 0 = all hardware threads (default 0);\n"
     "                        results do not depend on it\n"
     "  --path P              simd (default) or scalar; results do not depend on it\n"
@@ -339,11 +344,22 @@ int run_solve(int argc, char** argv) {
     req.want_float = *precision == Precision::single;
   } else if (req.bodies_format == SceneFormat::npz) {
     // A binary scene runs in its own precision; a bad file is reported (exit
-    // 1) when it is read.
+    // 1) when it is read. Binary bodies and contacts of different precisions
+    // leave the choice to the caller: neither silently wins.
+    std::optional<NpyType> bodies, contacts;
     try {
-      req.want_float = npz_scene_precision(NpzArchive::map(req.bodies_path)) == NpyType::f4;
+      bodies = npz_scene_precision(NpzArchive::map(req.bodies_path));
+      if (req.contacts_format == SceneFormat::npz) contacts = npz_scene_precision(NpzArchive::map(req.contacts_path));
     } catch (const SceneError&) {
     }
+    if (bodies && contacts && *bodies != *contacts) {
+      const auto name = [](NpyType t) { return t == NpyType::f4 ? "float32 (float)" : "float64 (double)"; };
+      throw UsageError(req.bodies_path + " holds " + name(*bodies) + " values but " + req.contacts_path + " " +
+                       name(*contacts) +
+                       ": say which precision to solve the scene in with --precision float or "
+                       "--precision double");
+    }
+    req.want_float = bodies == NpyType::f4;
   }
   req.threads = parse_threads(opt);
   if (const auto it = opt.find("path"); it != opt.end()) {
@@ -379,11 +395,7 @@ int run_solve(int argc, char** argv) {
     }
   }
   if (const auto it = opt.find("passes"); it != opt.end()) {
-    const unsigned long long passes = parse_count("passes", it->second);
-    if (passes < 1 || passes > 1000000) {
-      throw UsageError("--passes must be from 1 to 1000000, got '" + it->second + "'");
-    }
-    req.passes = static_cast<int>(passes);
+    req.passes = static_cast<int>(parse_integer("passes", it->second, 1, kMaxPasses));
   }
   if (const auto it = opt.find("layout"); it != opt.end()) {
     if (it->second == "auto") {

@@ -5,6 +5,9 @@
 // * Exit codes are part of the interface (scripts and tests rely on them):
 //   0 success, 1 bad input or an I/O failure (nothing written), 2 usage
 //   error, 3 `solve --check` found an error above the documented bound.
+// * A usage error prints one line that says what is wrong and "see
+//   'collide <command> --help'", not the whole help: the line is what a
+//   reader must find in a script's log.
 // * Options are GNU-style long options, "--name value" or "--name=value";
 //   an option given twice is a usage error rather than "last one wins", so
 //   a typo in a script cannot silently override an earlier value.
@@ -43,7 +46,11 @@ using Options = std::map<std::string, std::string>;
 Options parse_options(int argc, char** argv, int first, const std::vector<OptionSpec>& specs);
 /// The value of a required option. Throws UsageError when it is missing.
 const std::string& required(const Options& options, const std::string& name);
-/// Parses a non-negative decimal integer option value. Throws UsageError.
+/// Parses a decimal integer option value from `least` to `most`; otherwise
+/// UsageError("--passes must be an integer from 1 to 1000000, got '-1'").
+unsigned long long parse_integer(const std::string& name, const std::string& value, unsigned long long least,
+                                 unsigned long long most);
+/// parse_integer from 0 to the largest 64-bit value (a seed).
 unsigned long long parse_count(const std::string& name, const std::string& value);
 
 /// The precision a scene is read, solved or written in.

@@ -8,11 +8,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <string>
 #include <string_view>
 
 #include <oneapi/tbb/global_control.h>
 
+#include "collide/solve.hpp"
 #include "commands.hpp"
 
 namespace collide::cli {
@@ -83,14 +85,20 @@ const std::string& required(const Options& options, const std::string& name) {
   return it->second;
 }
 
-unsigned long long parse_count(const std::string& name, const std::string& value) {
+unsigned long long parse_integer(const std::string& name, const std::string& value, unsigned long long least,
+                                 unsigned long long most) {
   unsigned long long n = 0;
   const char* end = value.data() + value.size();
   const auto [ptr, ec] = std::from_chars(value.data(), end, n);
-  if (value.empty() || ec != std::errc() || ptr != end) {
-    throw UsageError("option '--" + name + "' needs a non-negative integer, got '" + value + "'");
+  if (value.empty() || ec != std::errc() || ptr != end || n < least || n > most) {
+    throw UsageError("--" + name + " must be an integer from " + std::to_string(least) + " to " + std::to_string(most) +
+                     ", got '" + value + "'");
   }
   return n;
+}
+
+unsigned long long parse_count(const std::string& name, const std::string& value) {
+  return parse_integer(name, value, 0, std::numeric_limits<unsigned long long>::max());
 }
 
 std::optional<Precision> parse_precision(const Options& options) {
@@ -104,9 +112,7 @@ std::optional<Precision> parse_precision(const Options& options) {
 int parse_threads(const Options& options) {
   const auto it = options.find("threads");
   if (it == options.end()) return 0;
-  const unsigned long long n = parse_count("threads", it->second);
-  if (n > 4096) throw UsageError("--threads " + it->second + " is too many");
-  return static_cast<int>(n);
+  return static_cast<int>(parse_integer("threads", it->second, 0, kMaxThreads));
 }
 
 struct ThreadLimit::Control {
@@ -144,14 +150,13 @@ int main(int argc, char** argv) {
     if (command == "gen") return run_gen(argc, argv);
     if (command == "report") return run_report(argc, argv);
     if (command == "convert") return run_convert(argc, argv);
-    std::fprintf(stderr, "collide: unknown command '%s'\n\n%s", argv[1], kMainUsage);
+    std::fprintf(stderr,
+                 "collide: unknown command '%s' (the commands: solve, gen, convert, report)\nsee 'collide --help'\n",
+                 argv[1]);
     return kExitUsage;
   } catch (const UsageError& e) {
-    const char* usage = command == "solve"     ? kSolveUsage
-                        : command == "report"  ? kReportUsage
-                        : command == "convert" ? kConvertUsage
-                                               : kGenUsage;
-    std::fprintf(stderr, "collide %s: %s\n\n%s", argv[1], e.what(), usage);
+    // The one line that says what is wrong, and where the options are.
+    std::fprintf(stderr, "collide %s: %s\nsee 'collide %s --help'\n", argv[1], e.what(), argv[1]);
     return kExitUsage;
   } catch (const std::bad_alloc&) {
     std::fputs("collide: out of memory\n", stderr);

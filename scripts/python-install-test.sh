@@ -29,6 +29,9 @@ J, stats = collide.solve(bodies, contacts)
 err = collide.impulse_error(J, ref)
 assert stats["collisions"] == 10000 and float(err.max()) <= collide.error_bound_eps
 print("import collide and solve: ok,", stats["isa"], stats["collisions_per_second"], "collisions/s")
+import os
+from collide import _build
+assert os.path.exists(_build.PYTHON), _build.PYTHON  # the interpreter `import collide` names when it cannot run
 import collide.dask
 assert collide.dask.__file__.startswith(__import__("sys").prefix), collide.dask.__file__
 PY

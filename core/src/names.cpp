@@ -36,7 +36,8 @@ const char* to_string(Order order) { return order == Order::colour ? "colour" : 
 Order parse_order(std::string_view name) {
   if (name == "input") return Order::input;
   if (name == "colour") return Order::colour;
-  throw std::invalid_argument("unknown order '" + std::string(name) + "' (expected input or colour)");
+  const std::string hint = name == "color" ? ": did you mean 'colour'?" : "";
+  throw std::invalid_argument("unknown order '" + std::string(name) + "' (expected input or colour)" + hint);
 }
 
 }  // namespace collide

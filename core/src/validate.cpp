@@ -407,7 +407,76 @@ bool screen_contacts(const ContactView<T>& c, std::size_t body_count, std::size_
   return c.mu == nullptr || screen_values(c.mu + k0, m, true);
 }
 
+// ---------------------------------------------------------------------------
+// Shared memory: the arrays of a solve as bytes, for validate_disjoint.
+// ---------------------------------------------------------------------------
+
+/// The arrays of one solve's views: at most 17 of the bodies, 10 of the
+/// contacts and 3 of the impulses.
+struct SolveArrays {
+  std::array<ArrayBytes, 32> list{};
+  std::size_t size = 0;
+  void add(const char* owner, const char* name, const void* data, std::size_t bytes, bool written) {
+    list[size++] = {owner, name, data, bytes, written};
+  }
+};
+
+/// The arrays of SoA bodies: each with its role (the velocities are written).
+template <class View>
+void add_bodies(SolveArrays& arrays, const View& b) {
+  for_each_array(b, [&](const char* name, const auto* data, ArrayRole role) {
+    arrays.add("bodies", name, data, b.count * sizeof(*data), role == ArrayRole::velocity);
+  });
+}
+/// Packed records are written whole; rigid records' inverse masses are read.
+template <class T>
+void add_bodies(SolveArrays& arrays, const PackedView<PackedRigid<T>>& b) {
+  arrays.add("bodies", "records", b.bodies, b.count * sizeof(PackedRigid<T>), true);
+  arrays.add("bodies", "inv_mass", b.inv_mass, b.count * sizeof(T), false);
+}
+template <class Record>
+void add_bodies(SolveArrays& arrays, const PackedView<Record>& b) {
+  arrays.add("bodies", "records", b.bodies, b.count * sizeof(Record), true);
+}
+
+template <class T, class View>
+Validation check_disjoint(const View& bodies, const ContactView<T>& c, const ImpulseView<T>& j) {
+  SolveArrays arrays;
+  add_bodies(arrays, bodies);
+  const std::size_t m = c.count;
+  arrays.add("contacts", "a", c.a, m * sizeof(BodyIndex), false);
+  arrays.add("contacts", "b", c.b, m * sizeof(BodyIndex), false);
+  const std::pair<const char*, const T*> values[] = {{"c.x", c.c.x}, {"c.y", c.c.y}, {"c.z", c.c.z}, {"n.x", c.n.x},
+                                                     {"n.y", c.n.y}, {"n.z", c.n.z}, {"e", c.e},     {"mu", c.mu}};
+  for (const auto& [name, data] : values) arrays.add("contacts", name, data, m * sizeof(T), false);
+  arrays.add("impulses", "j.x", j.j.x, j.count * sizeof(T), true);
+  arrays.add("impulses", "j.y", j.j.y, j.count * sizeof(T), true);
+  arrays.add("impulses", "j.z", j.j.z, j.count * sizeof(T), true);
+  return validate_disjoint(arrays.list.data(), arrays.size);
+}
+
 }  // namespace
+
+Validation validate_disjoint(const ArrayBytes* arrays, std::size_t count) {
+  const auto named = [](const ArrayBytes& x) { return std::string(x.owner) + "." + x.name; };
+  for (std::size_t i = 0; i < count; ++i) {
+    const ArrayBytes& x = arrays[i];
+    if (x.data == nullptr || x.bytes == 0) continue;
+    const auto x0 = reinterpret_cast<std::uintptr_t>(x.data);
+    for (std::size_t k = i + 1; k < count; ++k) {
+      const ArrayBytes& y = arrays[k];
+      if ((!x.written && !y.written) || y.data == nullptr || y.bytes == 0) continue;
+      const auto y0 = reinterpret_cast<std::uintptr_t>(y.data);
+      if (x0 < y0 + y.bytes && y0 < x0 + x.bytes) {
+        const std::string how = x.written && y.written ? "the solve writes both"
+                                : x.written            ? "the solve writes " + named(x) + " while it reads " + named(y)
+                                                       : "the solve writes " + named(y) + " while it reads " + named(x);
+        return fail_text(named(x) + " and " + named(y) + " share memory: " + how);
+      }
+    }
+  }
+  return {};
+}
 
 template <class T>
 bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count) {
@@ -444,6 +513,8 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
     }
   }
 
+  if (Validation v = check_disjoint<T>(bodies, contacts, impulses); !v) return v;
+
   const bool uniform_e_ok = contacts.e != nullptr || (contacts.uniform_e >= T(0) && contacts.uniform_e <= T(1));
   if (uniform_e_ok &&
       detail::screen_chunks(bodies.count,
@@ -475,7 +546,12 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
     }
     const T n[3] = {contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]};
     const double nn = length_in_double(n, 3);
-    if (!unit_length_ok(nn)) return fail("contacts", "|n|", k, nn, "must be 1 within 1e-3");
+    if (!unit_length_ok(nn)) {
+      std::ostringstream s;
+      s.precision(9);
+      s << "contact " << k << ": normal length " << nn << " is not 1 within 1e-3";
+      return fail_text(s.str());
+    }
     if (contacts.e && !(contacts.e[k] >= T(0) && contacts.e[k] <= T(1))) {
       return fail("contacts", "e", k, contacts.e[k], "must be in [0, 1]");
     }

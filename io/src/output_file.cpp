@@ -63,6 +63,20 @@ std::string rename_target(const std::string& path) {
 
 std::string errno_text(const char* what, int err) { return std::string(what) + ": " + std::strerror(err); }
 
+/// Creates the directory `dir` of output `path` and its missing parents, as
+/// `collide gen` creates its output directory; nothing for "" (the current
+/// directory) or a directory that exists.
+void create_directory(const std::string& path, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (dir.empty() || fs::is_directory(dir, ec)) return;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    const int err = ec ? ec.value() : ENOTDIR;
+    throw SceneError(path, "cannot create directory '" + dir + "': " + std::strerror(err), err);
+  }
+}
+
 }  // namespace
 
 OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
@@ -95,6 +109,7 @@ OutputFile::OutputFile(std::string path) : path_(std::move(path)) {
   dest_ = rename_target(path_);
   const std::filesystem::path dest(dest_);
   const std::string dir = dest.parent_path().string();
+  create_directory(path_, dir);
   // Same directory as the destination, so that rename() is atomic and never
   // crosses a file system; hidden, so a crash leaves no plausible output.
   std::string templ = (dir.empty() ? std::string() : dir + "/") + "." + dest.filename().string() + ".tmp-XXXXXX";

@@ -18,11 +18,39 @@ The law, the error measure and the bound (``error_bound_eps``) are those of
 ``collide solve --check``; docs/python.md describes the API.
 """
 
-from __future__ import annotations
+import os as _os
+import sys as _sys
 
-import numpy as _np
 
-from . import _collide
+def _cannot_run(what, missing, fix_here, error):
+    """ImportError saying what the module needs and which interpreter this
+    build's extension is for (python/collide/_build.py.in, written when the
+    build is configured): the fix is to run that one, or to build for this
+    one."""
+    try:
+        from ._build import PYTHON, PYTHON_VERSION
+    except ImportError:
+        PYTHON, PYTHON_VERSION = "the interpreter of its build", "?"
+    here = _sys.executable
+    version = ".".join(str(x) for x in _sys.version_info[:2])
+    if _os.path.exists(PYTHON) and _os.path.realpath(PYTHON) == _os.path.realpath(here):
+        return ImportError(f"{what}: this module was built for {PYTHON}, this interpreter, which has {missing}: "
+                           f"{fix_here} ({error})")
+    return ImportError(f"{what}: this module was built for {PYTHON} (Python {PYTHON_VERSION}), and this is {here} "
+                       f"(Python {version}), which has {missing}: run it with {PYTHON}, or build collide for this "
+                       f"interpreter (pip install . here, or cmake -DPython3_EXECUTABLE={here}) ({error})")
+
+
+try:
+    import numpy as _np
+except ImportError as _error:
+    raise _cannot_run("collide needs NumPy", "no NumPy", "install it (Debian: python3-numpy; pip: numpy)",
+                      _error) from _error
+try:
+    from . import _collide
+except ImportError as _error:
+    raise _cannot_run("collide's extension (collide._collide) cannot be loaded", "no build of it",
+                      "build it again (scripts/build.sh, or pip install .)", _error) from _error
 from ._collide import (
     Bodies,
     Contacts,
@@ -74,6 +102,12 @@ __all__ = [
 __version__ = "0.1.0"
 
 
+def __dir__():
+    """The API (``__all__``) and the version: not the modules the package
+    imports for itself."""
+    return sorted([*__all__, "__version__"])
+
+
 class Stats(dict):
     """The statistics of a solve, as :func:`solve` and :meth:`Solver.solve`
     return them: a dict with the keys of ``collide solve --stats``, shown one
@@ -111,8 +145,11 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     (the law in input order) or "colour" (an order collide chooses: windows
     of contacts coloured over their bodies, several times faster on piles,
     stacks and chains; docs/collision-law.md, "The solve order"); a
-    ``schedule`` given must have been built in it. ``passes`` resolves the
-    contacts that many times in that order, J summed. For frame loops build a
+    ``schedule`` given must have been built in it. ``passes`` (an integer
+    from 1 to 1000000, as ``collide solve --passes``) resolves the contacts
+    that many times in that order, J summed. No array the solve writes (v, w
+    or the records, and ``out``) may share memory with another of its arrays
+    (ValueError naming both). For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
     solving. Bad input raises TypeError or ValueError and modifies nothing.
 
@@ -195,7 +232,9 @@ def generate(kind, n, *, seed=1, model="rigid", friction=False, shuffle=False, d
     immovable ground; contacts in broadphase cell order, or in a seeded random
     order with ``shuffle=True``) or "chain" (n + 1 boxes in a staircase, each
     touching the next, n contacts in chain order, which run one after
-    another). Returns ``(Bodies, Contacts)`` over new arrays."""
+    another). ``n`` takes the range of ``collide gen``: from 1 to what 32-bit
+    body ids allow (ValueError outside it, TypeError for a non-integer).
+    Returns ``(Bodies, Contacts)`` over new arrays."""
     return _collide.generate(kind, n, seed=seed, model=model, friction=friction, shuffle=shuffle, dtype=dtype)
 
 

@@ -1,6 +1,6 @@
 """Type stubs of the collide package (see __init__.py and docs/python.md)."""
 
-from typing import Any, Literal, Sequence
+from typing import Any, Literal, Sequence, SupportsIndex
 
 import os
 
@@ -13,11 +13,14 @@ ModelName = Literal["auto", "rigid", "sphere", "particle"]
 PathName = Literal["simd", "scalar"]
 IsaName = Literal["auto", "sse2", "avx2", "avx512"]
 AccuracyName = Literal["fast", "accurate"]
+OrderName = Literal["input", "colour"]
 
 __version__: str
 error_bound_eps: float
 error_target_eps: float
 accurate_error_ulps: float
+
+def __dir__() -> list[str]: ...
 
 class Stats(dict[str, Any]):
     """The statistics of a solve: a dict with the keys of `collide solve --stats`.
@@ -46,12 +49,14 @@ class Bodies:
         w: FloatArray,
     ) -> None: ...
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
 
 class MappedFile:
     """A scene file mapped into memory: the base of the arrays load() leaves in it."""
     path: str
     address: int
     size: int
+    def __repr__(self) -> str: ...
 
 class Contacts:
     """M contacts: a, b uint32 (M,), c, n (3, M), e and mu (M,) or None."""
@@ -75,6 +80,7 @@ class Contacts:
         mu: FloatArray | None = None,
     ) -> None: ...
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
 
 class PackedBodies:
     """N packed bodies over the caller's records (no copy): a 1-D array of
@@ -107,6 +113,7 @@ class PackedBodies:
         inv_mass: FloatArray | None = None,
     ) -> None: ...
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
     def unpack(self, into: Bodies | None = None) -> Bodies: ...
     def unpack_velocities(self, into: Bodies) -> Bodies: ...
 
@@ -115,22 +122,39 @@ AnyBodies = Bodies | PackedBodies
 class Schedule:
     """The batches of a contact set; reusable while indices and inverse masses stay."""
 
+    order: OrderName
     batches: int
     largest_batch: int
+    colours: int
+    overflow_contacts: int
     build_seconds: float
-    def __init__(self, bodies: AnyBodies, contacts: Contacts) -> None: ...
+    def __init__(self, bodies: AnyBodies, contacts: Contacts, *, order: OrderName = "input") -> None: ...
+    def solve_order(self) -> npt.NDArray[np.uint32]: ...
+    def __repr__(self) -> str: ...
 
 class Solver:
     """A reusable solver (its thread arena and options) for frame loops."""
 
+    path: PathName
+    threads: int
+    isa: IsaName
+    accuracy: AccuracyName
+    order: OrderName
+    passes: int
     def __init__(
         self,
         *,
         path: PathName = "simd",
-        threads: int = 0,
+        threads: SupportsIndex = 0,
         isa: IsaName | None = None,
         accuracy: AccuracyName = "fast",
-    ) -> None: ...
+        order: OrderName = "input",
+        passes: SupportsIndex = 1,
+    ) -> None:
+        """``threads`` from 0 (all) to 4096 and ``passes`` from 1 to 1000000,
+        as the command's options: TypeError for a value that is not an
+        integer, ValueError outside the range."""
+    def __repr__(self) -> str: ...
     def solve(
         self,
         bodies: AnyBodies,
@@ -152,6 +176,7 @@ class Reference:
     impulse_scale: npt.NDArray[np.float64]
     dtype: np.dtype[Any]
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
 
 def solve(
     bodies: AnyBodies,
@@ -159,9 +184,11 @@ def solve(
     *,
     model: ModelName = "auto",
     path: PathName = "simd",
-    threads: int = 0,
+    threads: SupportsIndex = 0,
     isa: IsaName | None = None,
     accuracy: AccuracyName = "fast",
+    order: OrderName = "input",
+    passes: SupportsIndex = 1,
     schedule: Schedule | None = None,
     out: FloatArray | None = None,
     check: bool = True,
@@ -178,14 +205,22 @@ class Islands:
     largest: int
     largest_label: int
     def __len__(self) -> int: ...
+    def __repr__(self) -> str: ...
 
 def islands(bodies: AnyBodies, contacts: Contacts, *, threads: int = 0) -> Islands: ...
-def reference_solve(bodies: AnyBodies, contacts: Contacts) -> Reference: ...
+def reference_solve(
+    bodies: AnyBodies,
+    contacts: Contacts,
+    *,
+    order: OrderName = "input",
+    passes: SupportsIndex = 1,
+    schedule: Schedule | None = None,
+) -> Reference: ...
 def conservation_drift(bodies: AnyBodies, reference: Reference) -> dict[str, float]: ...
 def impulse_error(J: FloatArray, reference: Reference) -> npt.NDArray[np.float64]: ...
 def generate(
     kind: Literal["pairs", "debris", "pile", "chain"],
-    n: int,
+    n: SupportsIndex,
     *,
     seed: int = 1,
     model: Literal["rigid", "sphere", "particle"] = "rigid",

@@ -20,6 +20,21 @@ Dtype parse_dtype(const py::object& dtype) {
   throw py::type_error("dtype must be numpy.float32 or numpy.float64, got " + text(dtype));
 }
 
+long long integer_argument(const py::handle& obj, const std::string& name, long long least, long long most) {
+  const auto message = [&] {
+    return name + " must be an integer from " + std::to_string(least) + " to " + std::to_string(most) + ", got " +
+           py::repr(obj).cast<std::string>();
+  };
+  if (PyIndex_Check(obj.ptr()) == 0) throw py::type_error(message());
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(obj.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long n = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (n == -1 && PyErr_Occurred() != nullptr) throw py::error_already_set();
+  if (overflow != 0 || n < least || n > most) throw py::value_error(message());
+  return n;
+}
+
 Dtype scene_dtype(const std::string& what, const py::handle& obj) {
   if (!py::isinstance<py::array>(obj)) {
     throw py::type_error(what + " must be a numpy.ndarray, got " + text(py::type::of(obj)));
@@ -107,6 +122,21 @@ void require_length(const std::string& owner, const char* name, const py::array&
     throw py::value_error(owner + "." + name + " has " + std::to_string(length(a)) + " elements, " + first + " has " +
                           std::to_string(n));
   }
+}
+
+void add_bytes(std::vector<ArrayBytes>& out, const char* owner, const char* name, const py::array& a, bool written) {
+  if (a.ndim() != 2) {
+    out.push_back({owner, name, a.data(), static_cast<std::size_t>(a.nbytes()), written});
+    return;
+  }
+  const auto row_bytes = static_cast<std::size_t>(a.shape(1)) * static_cast<std::size_t>(a.itemsize());
+  for (py::ssize_t r = 0; r < a.shape(0); ++r) {
+    out.push_back({owner, name, static_cast<const char*>(a.data()) + r * a.strides(0), row_bytes, written});
+  }
+}
+
+void require_disjoint(const std::vector<ArrayBytes>& arrays) {
+  if (const Validation v = validate_disjoint(arrays.data(), arrays.size()); !v) throw py::value_error(v.message);
 }
 
 }  // namespace collide::python

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "collide/bodies.hpp"
+#include "collide/validate.hpp"
 
 namespace collide::python {
 
@@ -36,6 +37,11 @@ namespace py = pybind11;
 
 /// str(h).
 std::string text(const py::handle& h);
+
+/// "1 contact", "2 contacts": a count and its noun, for reprs.
+inline std::string counted(std::size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
 
 /// The precision of a scene.
 enum class Dtype { f32, f64 };
@@ -45,6 +51,12 @@ const char* dtype_name(Dtype d);
 py::dtype numpy_dtype(Dtype d);
 /// A dtype argument (numpy.float32, "float64", ...); TypeError for another.
 Dtype parse_dtype(const py::object& dtype);
+/// An integer argument from `least` to `most`: a Python int (or anything
+/// with __index__, such as numpy.int64), else TypeError, and in the range,
+/// else ValueError, both saying "<name> must be an integer from 1 to
+/// 1000000, got 2.5", in the caller's terms rather than pybind11's.
+long long integer_argument(const py::handle& obj, const std::string& name, long long least, long long most);
+
 /// The dtype of a scene, from its first floating-point array `what`
 /// (TypeError when it is not an ndarray of float32 or float64).
 Dtype scene_dtype(const std::string& what, const py::handle& obj);
@@ -83,6 +95,17 @@ inline std::size_t length(const py::array& a) { return static_cast<std::size_t>(
 /// ValueError("<owner>.<name> has 79 elements, <first> has 80") unless `a`
 /// has n elements.
 void require_length(const std::string& owner, const char* name, const py::array& a, std::size_t n, const char* first);
+
+/// Appends the bytes a solve touches in `a`, an array of scene values
+/// checked by checked_array, "<owner>.<name>", to `out`
+/// (collide::validate_disjoint's list): each row of a (rows, N) array apart,
+/// since the rows of one array may lie apart in a larger one (a (6, N)
+/// array's even rows as v, its odd rows as w), else the whole array. `owner`
+/// and `name` must outlive `out` (string literals).
+void add_bytes(std::vector<ArrayBytes>& out, const char* owner, const char* name, const py::array& a, bool written);
+/// ValueError("bodies.v and bodies.w share memory: the solve writes both")
+/// when an array of `arrays` the solve writes shares memory with another.
+void require_disjoint(const std::vector<ArrayBytes>& arrays);
 
 /// Whether NumPy lets the array be written.
 bool writeable(const py::array& a);

@@ -151,8 +151,21 @@ py::tuple load_py(const std::string& bodies_path, const std::string& contacts_pa
   if (!dtype_in.is_none()) {
     d = parse_dtype(dtype_in);
   } else if (scene_format_of(bodies_path) == SceneFormat::npz) {
-    // A binary scene in its own precision: mapped, not converted.
-    d = npz_scene_precision(NpzArchive::map(bodies_path)) == NpyType::f4 ? Dtype::f32 : Dtype::f64;
+    // A binary scene in its own precision: mapped, not converted. Binary
+    // files of two precisions leave the choice to the caller, as `collide
+    // solve` does without --precision.
+    const NpyType bodies = npz_scene_precision(NpzArchive::map(bodies_path));
+    if (scene_format_of(contacts_path) == SceneFormat::npz) {
+      const NpyType contacts = npz_scene_precision(NpzArchive::map(contacts_path));
+      if (contacts != bodies) {
+        const auto name = [](NpyType t) { return t == NpyType::f4 ? "float32" : "float64"; };
+        throw py::value_error(bodies_path + " holds " + name(bodies) + " values but " + contacts_path + " " +
+                              name(contacts) +
+                              ": say which precision to load the scene in with "
+                              "dtype=numpy.float32 or dtype=numpy.float64");
+      }
+    }
+    d = bodies == NpyType::f4 ? Dtype::f32 : Dtype::f64;
   }
   return with_dtype(d, [&](auto tag) { return load_t<decltype(tag)>(bodies_path, contacts_path, d); });
 }
@@ -186,7 +199,11 @@ void register_files(py::module_& m) {
                          "A scene file mapped into memory: the base of the arrays collide.load() leaves in it.")
       .def_readonly("path", &MappedFile::path)
       .def_readonly("address", &MappedFile::address)
-      .def_readonly("size", &MappedFile::size);
+      .def_readonly("size", &MappedFile::size)
+      .def("__repr__", [](const MappedFile& f) {
+        return "collide.MappedFile(" + py::repr(py::str(f.path)).cast<std::string>() + ", " + std::to_string(f.size) +
+               " bytes)";
+      });
   m.def("load", &load_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("dtype") = py::none());
   m.def("read_scene", &read_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::kw_only(), py::arg("dtype"));
   m.def("write_scene", &write_scene_py, py::arg("bodies_csv"), py::arg("contacts_csv"), py::arg("bodies"),

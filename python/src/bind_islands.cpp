@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "bindings.hpp"
@@ -85,6 +86,18 @@ void register_islands(py::module_& m) {
       .def_property_readonly("largest", [](const PyIslands& s) { return s.islands.largest; })
       .def_property_readonly("largest_label", [](const PyIslands& s) { return s.islands.largest_island; })
       .def("__len__", [](const PyIslands& s) { return s.islands.count(); })
+      .def("__repr__",
+           [](const PyIslands& s) {
+             const Islands& i = s.islands;
+             std::string text = "collide.Islands(" + counted(i.count(), "island", "islands") + " of " +
+                                counted(i.contact_island.size(), "contact", "contacts") + " over " +
+                                counted(i.body_island.size(), "body", "bodies");
+             if (i.count() > 0) {
+               text += "; the largest, island " + std::to_string(i.largest_island) + ", has " +
+                       counted(i.largest, "contact", "contacts");
+             }
+             return text + ")";
+           })
       .def_property_readonly_static("NONE", [](const py::object&) { return Islands::kNone; });
   m.def("islands", &islands_py<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(), py::arg("threads") = 0);
   m.def("islands", &islands_py<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),

@@ -344,14 +344,15 @@ void PackedBodies::set_inv_mass(const py::object& inv_mass_in) {
   }
   const py::array m = checked_array("packed", "inv_mass", inv_mass_in, numpy_dtype(dtype), dtype_name(dtype), 0, false);
   require_length("packed", "inv_mass", m, count, "packed.records");
-  const auto r0 = reinterpret_cast<std::uintptr_t>(records.data());
-  const auto m0 = reinterpret_cast<std::uintptr_t>(m.data());
-  const std::size_t t = dtype == Dtype::f32 ? sizeof(float) : sizeof(double);
-  if (count != 0 && m0 < r0 + count * record_size(model, dtype) && r0 < m0 + count * t) {
-    throw py::value_error(
-        "packed.inv_mass overlaps packed.records: the solve writes the records while it reads the inverse masses");
-  }
   inv_mass = m;
+  std::vector<ArrayBytes> arrays;
+  add_bytes(arrays, *this);
+  require_disjoint(arrays);  // the solve writes the records while it reads the inverse masses
+}
+
+void add_bytes(std::vector<ArrayBytes>& out, const PackedBodies& b) {
+  out.push_back({"packed", "records", b.records.data(), b.count * record_size(b.model, b.dtype), true});
+  if (b.inv_mass) add_bytes(out, "packed", "inv_mass", *b.inv_mass, false);
 }
 
 // ---------------------------------------------------------------------------
@@ -367,6 +368,13 @@ void register_packed(py::module_& m) {
       .def_property_readonly("dtype", [](const PackedBodies& b) { return numpy_dtype(b.dtype); })
       .def_property_readonly("record_dtype", [](const PackedBodies& b) { return record_dtype(b.model, b.dtype); })
       .def("__len__", [](const PackedBodies& b) { return b.count; })
+      .def("__repr__",
+           [](const PackedBodies& b) {
+             return "collide.PackedBodies(" + std::to_string(b.count) + " " + to_string(b.model) +
+                    (b.count == 1 ? " record, " : " records, ") + dtype_name(b.dtype) + ", " +
+                    std::to_string(record_size(b.model, b.dtype)) + " bytes each" +
+                    (b.inv_mass ? std::string(", inv_mass (N,) beside them") : std::string()) + ")";
+           })
       .def_property_readonly("structured", &structured,
                              "The records as a 1-D structured array of packed_dtype() (a view of the same memory; "
                              "rigid records have no inv_mass field: see inv_mass).")

@@ -34,6 +34,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "bindings.hpp"
 #include "collide/io/generate.hpp"
@@ -67,6 +68,28 @@ Bodies::Bodies(const py::object& inv_mass_in, const py::object& inv_inertia_in, 
     require_length(owner, name, *a, count, "inv_mass");
   }
   if (count > std::numeric_limits<BodyIndex>::max()) throw py::value_error("bodies: more than 2^32 - 1 bodies");
+  // The solve writes v and w: neither may share memory with another array.
+  std::vector<ArrayBytes> arrays;
+  add_bytes(arrays, *this);
+  require_disjoint(arrays);
+}
+
+void add_bytes(std::vector<ArrayBytes>& out, const Bodies& b) {
+  add_bytes(out, "bodies", "inv_mass", b.inv_mass, false);
+  add_bytes(out, "bodies", "inv_inertia", b.inv_inertia, false);
+  add_bytes(out, "bodies", "q", b.q, false);
+  add_bytes(out, "bodies", "p", b.p, false);
+  add_bytes(out, "bodies", "v", b.v, true);
+  add_bytes(out, "bodies", "w", b.w, true);
+}
+
+void add_bytes(std::vector<ArrayBytes>& out, const Contacts& c) {
+  add_bytes(out, "contacts", "a", c.a, false);
+  add_bytes(out, "contacts", "b", c.b, false);
+  add_bytes(out, "contacts", "c", c.c, false);
+  add_bytes(out, "contacts", "n", c.n, false);
+  if (c.e) add_bytes(out, "contacts", "e", *c.e, false);
+  if (c.mu) add_bytes(out, "contacts", "mu", *c.mu, false);
 }
 
 Contacts::Contacts(const py::object& a_in, const py::object& b_in, const py::object& c_in, const py::object& n_in,
@@ -107,21 +130,14 @@ Model parse_named_model(const std::string& s, const char* who) {
 
 namespace {
 
-py::tuple generate_py(const std::string& kind, std::size_t n, std::uint64_t seed, const std::string& model,
+py::tuple generate_py(const std::string& kind, const py::object& n_in, std::uint64_t seed, const std::string& model,
                       bool friction, bool shuffle, const py::object& dtype_in) {
   const Dtype d = parse_dtype(dtype_in);
-  if (kind != "pairs" && kind != "debris" && kind != "pile" && kind != "chain") {
-    throw py::value_error("kind must be 'pairs', 'debris', 'pile' or 'chain', got '" + kind + "'");
-  }
-  if (kind == "pile") {
-    // As `collide gen --pile S`: n boxes per side.
-    if (n < 1 || n > kMaxPileSide) {
-      throw py::value_error("a pile has from 1 to " + std::to_string(kMaxPileSide) + " boxes per side, got " +
-                            std::to_string(n));
-    }
-  } else if (n < 1 || n > 0x7FFFFFFFULL) {
-    throw py::value_error("n must be from 1 to 2^31 - 1");
-  }
+  const std::size_t most = max_scene_count(kind);
+  if (most == 0) throw py::value_error("kind must be 'pairs', 'debris', 'pile' or 'chain', got '" + kind + "'");
+  // The range of `collide gen --<kind> N` (for a pile, N boxes per side).
+  const auto n = static_cast<std::size_t>(
+      integer_argument(n_in, kind == "pile" ? "n (boxes per side of a pile)" : "n", 1, static_cast<long long>(most)));
   if (shuffle && kind != "pile") throw py::value_error("shuffle is for kind 'pile' only");
   GenerateOptions o;
   o.seed = seed;

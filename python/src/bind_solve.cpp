@@ -61,15 +61,18 @@ Path parse_path(const std::string& s) {
   throw py::value_error("path must be 'simd' or 'scalar', got '" + s + "'");
 }
 
-SolverOptions solver_options(const std::string& path, int threads, const py::object& isa, const std::string& accuracy,
-                             const std::string& order, int passes) {
+/// passes= of a solve or a reference solve: the range of `collide solve --passes`.
+int passes_argument(const py::object& passes) {
+  return static_cast<int>(integer_argument(passes, "passes", 1, kMaxPasses));
+}
+
+SolverOptions solver_options(const std::string& path, const py::object& threads, const py::object& isa,
+                             const std::string& accuracy, const std::string& order, const py::object& passes) {
   SolverOptions o;
   o.order = parse_order(order);
-  if (passes < 1) throw py::value_error("passes must be >= 1, got " + std::to_string(passes));
-  o.passes = passes;
+  o.passes = passes_argument(passes);
   o.path = parse_path(path);
-  if (threads < 0 || threads > 4096) throw py::value_error("threads must be from 0 (all) to 4096");
-  o.threads = threads;
+  o.threads = static_cast<int>(integer_argument(threads, "threads", 0, kMaxThreads));
   std::optional<std::string> isa_name;
   try {
     if (!isa.is_none()) isa_name = isa.cast<std::string>();
@@ -140,8 +143,8 @@ py::dict to_dict(const StatRecord& record) {
 struct PySolver {
   std::unique_ptr<Solver> solver;
 
-  PySolver(const std::string& path, int threads, const py::object& isa, const std::string& accuracy,
-           const std::string& order, int passes)
+  PySolver(const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
+           const std::string& order, const py::object& passes)
       : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy, order, passes))) {}
 
   template <class T, class B>
@@ -149,6 +152,15 @@ struct PySolver {
                     const py::object& out, bool check, bool impacts) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
+    {
+      // What the solve writes (v and w or the records, J) shares no memory
+      // with what it reads or writes besides: checked with check=False too.
+      std::vector<ArrayBytes> arrays;
+      add_bytes(arrays, bodies);
+      add_bytes(arrays, contacts);
+      add_bytes(arrays, "solve", "out", j, true);
+      require_disjoint(arrays);
+    }
     const ImpulseView<T> jv{contacts.count, vec3<T>(j)};  // rows one stride apart, as checked_array allows
     const ContactView<T> cv = contacts.view<T>();
     // Unchecked values are the caller's word; indices never are (memory
@@ -171,6 +183,12 @@ struct PySolver {
       throw py::value_error("schedule was built for " + std::to_string(schedule->contacts) + " contacts and " +
                             std::to_string(schedule->bodies) + " bodies, not " + std::to_string(contacts.count) +
                             " and " + std::to_string(bodies.count));
+    } else if (schedule->schedule.ordering() != solver->options().order) {
+      // The library's message names its C++ call; this one the Python one.
+      const std::string order = to_string(solver->options().order);
+      throw py::value_error(std::string("schedule is in ") + to_string(schedule->schedule.ordering()) +
+                            " order but the solver's order is '" + order +
+                            "': build it as collide.Schedule(bodies, contacts, order=\"" + order + "\")");
     }
     const Model model = solve_model<T>(bodies, cv, requested, check);
     SolveStats stats;
@@ -244,9 +262,9 @@ struct Reference {
 };
 
 std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const std::string& order,
-                                              int passes, const PySchedule* schedule) {
+                                              const py::object& passes_in, const PySchedule* schedule) {
   require_same_dtype(bodies, contacts);
-  if (passes < 1) throw py::value_error("reference_solve: passes must be >= 1, got " + std::to_string(passes));
+  const int passes = passes_argument(passes_in);
   return with_dtype(bodies.dtype, [&](auto tag) {
     using T = decltype(tag);
     validate_or_throw<T>(bodies, contacts);
@@ -328,6 +346,7 @@ class ThreadLimit {
   }
   void enter() { control_.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads_)); }
   void exit() { control_.reset(); }
+  [[nodiscard]] int threads() const { return threads_; }
 
  private:
   int threads_;
@@ -353,10 +372,23 @@ void register_solve(py::module_& m) {
             return out;
           },
           "The contact indices in the order a solve applies them (uint32, (M,)).")
-      .def_readonly("build_seconds", &PySchedule::build_seconds);
+      .def_readonly("build_seconds", &PySchedule::build_seconds)
+      .def("__repr__", [](const PySchedule& s) {
+        const Schedule& k = s.schedule;
+        std::string text = "collide.Schedule(" + counted(s.contacts, "contact", "contacts") + ", " +
+                           counted(s.bodies, "body", "bodies") + ", order '" + to_string(k.ordering()) +
+                           "': " + counted(k.batch_count(), "batch", "batches") + ", the largest " +
+                           counted(k.largest_batch(), "contact", "contacts");
+        if (k.ordering() == Order::colour) {
+          text += ", " + counted(k.colours(), "colour", "colours") + ", " +
+                  counted(k.overflow_contacts(), "overflow contact", "overflow contacts");
+        }
+        return text + ")";
+      });
 
   py::class_<PySolver>(m, "Solver")
-      .def(py::init<const std::string&, int, const py::object&, const std::string&, const std::string&, int>(),
+      .def(py::init<const std::string&, const py::object&, const py::object&, const std::string&, const std::string&,
+                    const py::object&>(),
            py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
            py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1)
       .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
@@ -365,6 +397,14 @@ void register_solve(py::module_& m) {
       .def_property_readonly("accuracy", [](const PySolver& s) { return to_string(s.solver->options().accuracy); })
       .def_property_readonly("order", [](const PySolver& s) { return to_string(s.solver->options().order); })
       .def_property_readonly("passes", [](const PySolver& s) { return s.solver->options().passes; })
+      .def("__repr__",
+           [](const PySolver& s) {
+             const SolverOptions& o = s.solver->options();
+             return std::string("collide.Solver(path='") + to_string(o.path) +
+                    "', threads=" + std::to_string(o.threads) + ", isa='" + to_string(s.solver->isa()) +
+                    "', accuracy='" + to_string(o.accuracy) + "', order='" + to_string(o.order) +
+                    "', passes=" + std::to_string(o.passes) + ")";
+           })
       .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
            py::arg("check") = true, py::arg("impacts") = true)
@@ -381,7 +421,8 @@ void register_solve(py::module_& m) {
             return t;
           },
           py::return_value_policy::reference)
-      .def("__exit__", [](ThreadLimit& t, const py::args&) { t.exit(); });
+      .def("__exit__", [](ThreadLimit& t, const py::args&) { t.exit(); })
+      .def("__repr__", [](const ThreadLimit& t) { return "collide.ThreadLimit(" + std::to_string(t.threads()) + ")"; });
 
   py::class_<Reference, std::shared_ptr<Reference>>(m, "Reference")
       .def_property_readonly("J", &Reference::j_array)
@@ -389,7 +430,12 @@ void register_solve(py::module_& m) {
       .def_property_readonly("w", [](const Reference& r) { return r.vec_array(true); })
       .def_property_readonly("impulse_scale", &Reference::impulse_scale)
       .def_property_readonly("dtype", [](const Reference& r) { return numpy_dtype(r.dtype); })
-      .def("__len__", [](const Reference& r) { return r.impulses.size(); });
+      .def("__len__", [](const Reference& r) { return r.impulses.size(); })
+      .def("__repr__", [](const Reference& r) {
+        return "collide.Reference(" + counted(r.impulses.size(), "contact", "contacts") + ", " +
+               counted(r.after.size(), "body", "bodies") + ", of a " + dtype_name(r.dtype) +
+               " scene: J, v, w and impulse_scale in float64)";
+      });
 
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
         py::arg("order") = "input", py::arg("passes") = 1, py::arg("schedule") = nullptr);

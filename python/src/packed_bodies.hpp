@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "arrays.hpp"
 #include "collide/packed.hpp"
@@ -61,6 +62,10 @@ struct PackedBodies {
                  bool has_inv_mass);
   void set_inv_mass(const py::object& inv_mass_in);
 };
+
+/// The records (written whole by a solve) and rigid records' inverse
+/// masses (read) as the bytes a solve touches (add_bytes of arrays.hpp).
+void add_bytes(std::vector<ArrayBytes>& out, const PackedBodies& b);
 
 /// f(PackedView<Record>) for the records' type, with value type T.
 template <class T, class F>

@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "arrays.hpp"
 #include "collide/bodies.hpp"
@@ -85,6 +86,12 @@ struct Contacts {
     return view;
   }
 };
+
+/// The arrays of a scene as the bytes a solve touches (add_bytes of
+/// arrays.hpp, for require_disjoint): the bodies' v and w written, every
+/// other array read.
+void add_bytes(std::vector<ArrayBytes>& out, const Bodies& b);
+void add_bytes(std::vector<ArrayBytes>& out, const Contacts& c);
 
 /// A new collide.Bodies over copies of `b`.
 /// 1/m and 1/I of `columns` as new (N,) and (3, N) arrays of dtype `d`: the

@@ -10,7 +10,11 @@
 //   * gen + solve --check round trips, both precisions and both paths;
 //   * the written numbers read back to the values the library computes;
 //   * inf of immovable bodies and all unchanged columns survive a solve;
-//   * usage errors: exit 2.
+//   * usage errors: exit 2, one line saying what is wrong and "see 'collide
+//     <command> --help'" (not the help itself); every count states its range
+//     (gen's scenes from 1, --passes from 1 to 1000000, --threads from 0 to
+//     4096), a misspelt order is named;
+//   * every output's missing directory is created.
 
 #include <algorithm>
 #include <charconv>
@@ -67,6 +71,19 @@ std::string replace_line(const std::string& text, std::size_t line, const std::s
   std::string out, l;
   for (std::size_t i = 0; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
   return out;
+}
+
+/// A usage error as the tool reports it: exit 2 and two lines on stderr,
+/// "collide <command>: what is wrong" and where the options are, not the help.
+void expect_one_usage_line(const RunResult& r, const std::string& command, const std::string& what) {
+  EXPECT_EQ(r.exit_code, 2) << what << "\n" << r.err;
+  const std::string prefix = "collide " + command + ": ";
+  const std::string see = "\nsee 'collide " + command + " --help'\n";
+  EXPECT_EQ(r.err.rfind(prefix, 0), 0U) << what << "\n" << r.err;
+  ASSERT_GE(r.err.size(), see.size()) << what << "\n" << r.err;
+  EXPECT_EQ(r.err.substr(r.err.size() - see.size()), see) << what << "\n" << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << what << "\n" << r.err;
+  EXPECT_EQ(r.err.find("usage:"), std::string::npos) << what << "\n" << r.err;
 }
 
 class CliTest : public ::testing::Test {
@@ -429,12 +446,15 @@ TEST_F(CliTest, OutputMayReplaceTheInput) {
 TEST_F(CliTest, UnwritableOutputWritesNothing) {
   spit(path("bodies.csv"), kBodies);
   spit(path("contacts.csv"), kContacts);
+  // A missing directory is created (OutputsCreateMissingDirectories); one a
+  // file stands in the way of cannot be.
+  spit(path("blocker"), "a file, not a directory");
   const RunResult r =
       run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
-           "--out-bodies", path("ob.csv").string(), "--out-impulses", path("missing/oj.csv").string()});
+           "--out-bodies", path("ob.csv").string(), "--out-impulses", path("blocker/oj.csv").string()});
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("missing/oj.csv"), std::string::npos) << r.err;
-  EXPECT_TRUE(stray_files().empty()) << stray_files().front();
+  EXPECT_NE(r.err.find("blocker/oj.csv"), std::string::npos) << r.err;
+  EXPECT_EQ(stray_files(), std::vector<std::string>{"blocker"});
 }
 
 TEST_F(CliTest, ExampleSceneSolvesAndChecks) {
@@ -795,9 +815,9 @@ TEST_F(CliTest, GenPileShuffleIsAPermutationOfTheRows) {
 
 TEST_F(CliTest, GenPileUsageErrorsSayWhy) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
-      {{"gen", "--pile", "1626", "--out", path("g").string()}, "--pile 1626 is too large: at most 1625 boxes per side"},
-      {{"gen", "--pile", "-3", "--out", path("g").string()}, "option '--pile' needs a non-negative integer"},
-      {{"gen", "--pile", "many", "--out", path("g").string()}, "option '--pile' needs a non-negative integer"},
+      {{"gen", "--pile", "1626", "--out", path("g").string()}, "--pile must be an integer from 1 to 1625, got '1626'"},
+      {{"gen", "--pile", "-3", "--out", path("g").string()}, "--pile must be an integer from 1 to 1625, got '-3'"},
+      {{"gen", "--pile", "many", "--out", path("g").string()}, "--pile must be an integer from 1 to 1625, got 'many'"},
       {{"gen", "--pile", "--out", path("g").string()}, "option '--pile' needs a value"},
       {{"gen", "--pile", "3", "--debris", "10", "--out", path("g").string()},
        "give exactly one of --pairs N, --debris N, --pile S and --chain N"},
@@ -813,7 +833,7 @@ TEST_F(CliTest, GenPileUsageErrorsSayWhy) {
     const RunResult r = run(args);
     EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
     EXPECT_NE(r.err.find(message), std::string::npos) << joined << "\n" << r.err;
-    EXPECT_NE(r.err.find("usage: collide gen"), std::string::npos) << joined << "\n" << r.err;
+    expect_one_usage_line(r, "gen", joined);
     EXPECT_FALSE(fs::exists(path("g"))) << joined;
   }
   // The help says what S is.
@@ -902,11 +922,105 @@ TEST_F(CliTest, UsageErrorsExitTwo) {
     std::string joined;
     for (const auto& a : args) joined += a + " ";
     EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
-    EXPECT_NE(r.err.find("usage: collide"), std::string::npos) << joined << "\n" << r.err;
+    if (args.empty()) {
+      EXPECT_NE(r.err.find("usage: collide"), std::string::npos) << r.err;  // no command: the commands
+    } else if (args[0] == "frobnicate") {
+      EXPECT_EQ(r.err,
+                "collide: unknown command 'frobnicate' (the commands: solve, gen, convert, report)\n"
+                "see 'collide --help'\n");
+    } else {
+      expect_one_usage_line(r, args[0], joined);
+    }
   }
   EXPECT_FALSE(fs::exists(ob));
   EXPECT_FALSE(fs::exists(oj));
   EXPECT_FALSE(fs::exists(path("g")));
+}
+
+// A count says its range, whichever way it is wrong: negative, zero, too
+// large or not a number.
+TEST_F(CliTest, CountsStateTheirRange) {
+  spit(path("bodies.csv"), kBodies);
+  spit(path("contacts.csv"), kContacts);
+  const std::vector<std::string> scene = {"solve",
+                                          "--bodies",
+                                          path("bodies.csv").string(),
+                                          "--contacts",
+                                          path("contacts.csv").string(),
+                                          "--out-bodies",
+                                          path("ob.csv").string(),
+                                          "--out-impulses",
+                                          path("oj.csv").string()};
+  const auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = scene;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+  };
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {with({"--passes", "-1"}), "collide solve: --passes must be an integer from 1 to 1000000, got '-1'\n"},
+      {with({"--passes", "0"}), "collide solve: --passes must be an integer from 1 to 1000000, got '0'\n"},
+      {with({"--passes", "1000001"}), "collide solve: --passes must be an integer from 1 to 1000000, got '1000001'\n"},
+      {with({"--passes", "2.5"}), "collide solve: --passes must be an integer from 1 to 1000000, got '2.5'\n"},
+      {with({"--threads", "-1"}), "collide solve: --threads must be an integer from 0 to 4096, got '-1'\n"},
+      {with({"--threads", "4097"}), "collide solve: --threads must be an integer from 0 to 4096, got '4097'\n"},
+      {with({"--order", "color"}),
+       "collide solve: --order: unknown order 'color' (expected input or colour): did you mean 'colour'?\n"},
+      {{"gen", "--pairs", "0", "--out", path("g").string()},
+       "collide gen: --pairs must be an integer from 1 to 2147483647, got '0'\n"},
+      {{"gen", "--debris", "0", "--out", path("g").string()},
+       "collide gen: --debris must be an integer from 1 to 4294967295, got '0'\n"},
+      {{"gen", "--pile", "0", "--out", path("g").string()},
+       "collide gen: --pile must be an integer from 1 to 1625, got '0'\n"},
+      {{"gen", "--chain", "0", "--out", path("g").string()},
+       "collide gen: --chain must be an integer from 1 to 4294967294, got '0'\n"},
+      {{"gen", "--pairs", "2147483648", "--out", path("g").string()},
+       "collide gen: --pairs must be an integer from 1 to 2147483647, got '2147483648'\n"},
+      {{"report", "--runs", "0"}, "collide report: --runs must be an integer from 1 to 1000, got '0'\n"},
+      {{"convert", "--in", path("bodies.csv").string(), "--out", path("b.npz").string(), "--threads", "x"},
+       "collide convert: --threads must be an integer from 0 to 4096, got 'x'\n"},
+  };
+  for (const auto& [args, first_line] : cases) {
+    std::string joined;
+    for (const auto& a : args) joined += a + " ";
+    const RunResult r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << joined << "\n" << r.err;
+    EXPECT_EQ(r.err, first_line + "see 'collide " + args[0] + " --help'\n") << joined;
+  }
+  EXPECT_FALSE(fs::exists(path("g")));
+  EXPECT_FALSE(fs::exists(path("ob.csv")));
+  EXPECT_FALSE(fs::exists(path("b.npz")));
+  // The least of each is accepted.
+  EXPECT_EQ(run(with({"--passes", "1", "--threads", "0"})).exit_code, 0);
+  for (const char* kind : {"--pairs", "--debris", "--pile", "--chain"}) {
+    const RunResult r = run({"gen", kind, "1", "--out", path(std::string("one") + kind).string()});
+    EXPECT_EQ(r.exit_code, 0) << kind << ": " << r.err;
+  }
+}
+
+// Every writer creates its output's missing directory (and its parents), as
+// gen creates its --out directory: solve's outputs, convert's, gen's.
+TEST_F(CliTest, OutputsCreateMissingDirectories) {
+  spit(path("bodies.csv"), kBodies);
+  spit(path("contacts.csv"), kContacts);
+  RunResult r =
+      run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+           "--out-bodies", path("nodir/ob.csv").string(), "--out-impulses", path("deeper/still/oj.npz").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(path("nodir/ob.csv")));
+  EXPECT_TRUE(fs::is_regular_file(path("deeper/still/oj.npz")));
+  r = run({"convert", "--in", path("nodir/ob.csv").string(), "--out", path("converted/a/b.npz").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(path("converted/a/b.npz")));
+  r = run({"gen", "--pairs", "3", "--out", path("gen/x/y").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(path("gen/x/y/bodies.csv")));
+  // A directory that cannot be created (a file is in its way): exit 1, named.
+  spit(path("file"), "x");
+  r = run({"solve", "--bodies", path("bodies.csv").string(), "--contacts", path("contacts.csv").string(),
+           "--out-bodies", path("file/sub/ob.csv").string(), "--out-impulses", path("oj2.csv").string()});
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot create directory '" + path("file/sub").string() + "'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("oj2.csv")));
 }
 
 TEST_F(CliTest, EqualsFormOfOptions) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -158,6 +159,44 @@ TEST_F(CliNpzTest, FloatSceneSolvesInItsOwnPrecision) {
   const RunResult d = solve("bodies.npz", "contacts.npz", "ob.npz", "oj.npz", {"--stats", "--precision", "double"});
   ASSERT_EQ(d.exit_code, 0) << d.err;
   EXPECT_NE(d.err.find("\"precision\": \"double\""), std::string::npos) << d.err;
+}
+
+// Binary bodies and contacts files of different precisions: neither file's
+// precision wins without a word; the run is refused (exit 2, nothing
+// written) and asks for --precision, which then decides.
+TEST_F(CliNpzTest, MixedPrecisionFilesNeedPrecision) {
+  for (const char* precision : {"float", "double"}) {
+    ASSERT_EQ(
+        run({"gen", "--pairs", "200", "--out", path(precision).string(), "--format", "npz", "--precision", precision})
+            .exit_code,
+        0);
+  }
+  for (const auto& [bodies, contacts] : {std::pair<std::string, std::string>{"double", "float"}, {"float", "double"}}) {
+    const std::string b = bodies + "/bodies.npz", c = contacts + "/contacts.npz";
+    const RunResult r = solve(b, c, "ob.npz", "oj.npz");
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(bodies == "double" ? "holds float64 (double) values but" : "holds float32 (float) values but"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("say which precision to solve the scene in with --precision float or --precision double"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find(path(b).string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(path(c).string()), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(path("oj.npz")));
+    for (const char* precision : {"float", "double"}) {
+      const RunResult ok = solve(b, c, "ob.npz", "oj.npz", {"--precision", precision, "--stats"});
+      ASSERT_EQ(ok.exit_code, 0) << ok.err;
+      EXPECT_NE(ok.err.find(std::string("\"precision\": \"") + precision + "\""), std::string::npos) << ok.err;
+    }
+    fs::remove(path("oj.npz"));
+  }
+  // CSV bodies: double, whatever a binary contacts file holds (the rule of
+  // --precision's default: the binary bodies file's own, else double).
+  ASSERT_EQ(run({"convert", "--in", path("float/bodies.npz").string(), "--out", path("b.csv").string()}).exit_code, 0);
+  const RunResult csv = solve("b.csv", "float/contacts.npz", "ob.csv", "oj.csv", {"--stats"});
+  ASSERT_EQ(csv.exit_code, 0) << csv.err;
+  EXPECT_NE(csv.err.find("\"precision\": \"double\""), std::string::npos) << csv.err;
 }
 
 TEST_F(CliNpzTest, ConvertIsExactBothWays) {

@@ -13,6 +13,11 @@
 //   the boundary), a quaternion whose |q|^2 is not a normal, finite number
 //   (the files' rule; any other length is accepted), indices out of range, a contact of a body with itself, e
 //   outside [0, 1] (per contact and uniform), mu negative or not finite.
+// * No array the solve writes shares memory with another array it writes
+//   or reads (v and w, the impulses, packed records): each pair is named,
+//   and views of one allocation whose arrays touch different bytes (the
+//   rows of a 2-D array, interleaved rows) pass, as do read arrays that
+//   share memory.
 // * The first problem in array order is the one reported.
 // * The vectorised screen that runs first (validate.cpp) changes no verdict:
 //   -0.0 inverse masses and |n| just inside the tolerance (which fail the
@@ -21,6 +26,7 @@
 // * Packed records (collide/packed.hpp) get the verdict and the message of the
 //   SoA view they were packed from, for every rule, and their padding is
 //   not read.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -128,7 +134,7 @@ std::vector<Rule<T>> rules() {
       {"itself", [](Fixture<T>& f) { mut(f.contacts.b)[2] = f.contacts.a[2]; }},
       {"contacts.c.y[2]", [=](Fixture<T>& f) { mut(f.contacts.c.y)[2] = nan; }},
       {"contacts.n.x[2]", [=](Fixture<T>& f) { mut(f.contacts.n.x)[2] = inf; }},
-      {"contacts.|n|[2]",
+      {"contact 2: normal length",
        [](Fixture<T>& f) {
          for (const T* n : {f.contacts.n.x, f.contacts.n.y, f.contacts.n.z}) mut(n)[2] *= T(0.99);
        }},
@@ -189,8 +195,9 @@ TYPED_TEST(Validate, NormalToleranceIsOneInAThousandAndQuaternionsAnyLength) {
   for (const double off : {1.001e-3, 2e-3}) {
     for (const double sign : {1.0, -1.0}) {
       const Validation v = scaled_units<T>(1, 1 + sign * off);
-      EXPECT_NE(v.message.find("contacts.|n|[2]"), std::string::npos) << "off by " << sign * off << ": " << v.message;
-      EXPECT_NE(v.message.find("must be 1 within 1e-3"), std::string::npos) << v.message;
+      EXPECT_NE(v.message.find("contact 2: normal length"), std::string::npos)
+          << "off by " << sign * off << ": " << v.message;
+      EXPECT_NE(v.message.find("is not 1 within 1e-3"), std::string::npos) << v.message;
     }
   }
 }
@@ -255,7 +262,7 @@ TYPED_TEST(Validate, ScreenChangesNoVerdict) {
   // normal number while just above it passes.
   Fixture<T> g;
   for (const T* n : {g.contacts.n.x, g.contacts.n.y, g.contacts.n.z}) mut(n)[2] *= T(1 + 1.005e-3);
-  EXPECT_NE(g.run().message.find("contacts.|n|[2]"), std::string::npos) << g.run().message;
+  EXPECT_NE(g.run().message.find("contact 2: normal length"), std::string::npos) << g.run().message;
   Fixture<T> h;
   for (T* q : {h.bodies.q.x, h.bodies.q.y, h.bodies.q.z}) q[5] = 0;
   h.bodies.q.w[5] = std::sqrt(std::numeric_limits<T>::min()) * T(1.5);
@@ -329,6 +336,96 @@ TYPED_TEST(Validate, PackedRecordsGetTheVerdictOfTheirSoAView) {
   pack(f.bodies, packed_view(rigid));
   const PackedView<PackedRigid<T>> no_masses{f.bodies.count, rigid.bodies.data(), nullptr};
   EXPECT_NE(validate(no_masses, f.contacts, f.impulses).message.find("bodies.inv_mass is null"), std::string::npos);
+}
+
+// Arrays the solve writes (v, w, the impulses, records) may share no byte
+// with another array of the solve; the message names both, and says which
+// one the solve writes.
+TYPED_TEST(Validate, WrittenArraysShareNoMemory) {
+  using T = TypeParam;
+  const auto message = [](const auto& bodies, const Fixture<T>& f) {
+    return validate(bodies, f.contacts, f.impulses).message;
+  };
+  {
+    Fixture<T> f;
+    f.bodies.w = f.bodies.v;  // the same array for v and w
+    EXPECT_EQ(f.run().message, "bodies.v.x and bodies.w.x share memory: the solve writes both");
+    EXPECT_EQ(message(sphere_view(f.bodies), f), "bodies.v.x and bodies.w.x share memory: the solve writes both");
+  }
+  {
+    Fixture<T> f;
+    f.bodies.v.y = f.bodies.p.x + 3;  // overlapping, not equal
+    EXPECT_EQ(f.run().message,
+              "bodies.p.x and bodies.v.y share memory: the solve writes bodies.v.y while it reads bodies.p.x");
+    EXPECT_EQ(message(particle_view(f.bodies), f), "") << "a particle solve reads no p";
+  }
+  {
+    Fixture<T> f;
+    f.impulses.j.z = mut(f.contacts.n.x);
+    EXPECT_EQ(f.run().message,
+              "contacts.n.x and impulses.j.z share memory: the solve writes impulses.j.z while it reads contacts.n.x");
+    Fixture<T> g;
+    g.impulses.j.y = g.bodies.w.z + 1;
+    EXPECT_EQ(g.run().message, "bodies.w.z and impulses.j.y share memory: the solve writes both");
+  }
+  {
+    // Arrays that are only read may share memory; an empty array shares nothing.
+    Fixture<T> f;
+    f.contacts.c = f.contacts.n;
+    f.bodies.p.y = f.bodies.p.x;
+    EXPECT_TRUE(f.run()) << f.run().message;
+    f.contacts.count = 0;
+    f.impulses.count = 0;
+    f.impulses.j.x = mut(f.contacts.n.x);
+    EXPECT_TRUE(f.run()) << f.run().message;
+  }
+  {
+    // One allocation holding v and w: the rows of a (6, N) array, then
+    // interleaved (v.x, w.x, v.y, w.y, ...), touch different bytes.
+    Fixture<T> f;
+    const std::size_t n = f.bodies.count;
+    std::vector<T> rows(6 * n);
+    const T* const from[6] = {f.bodies.v.x, f.bodies.v.y, f.bodies.v.z, f.bodies.w.x, f.bodies.w.y, f.bodies.w.z};
+    for (std::size_t r = 0; r < 6; ++r) std::copy(from[r], from[r] + n, rows.data() + r * n);
+    f.bodies.v = {rows.data(), rows.data() + n, rows.data() + 2 * n};
+    f.bodies.w = {rows.data() + 3 * n, rows.data() + 4 * n, rows.data() + 5 * n};
+    EXPECT_TRUE(f.run()) << f.run().message;
+    f.bodies.v = {rows.data(), rows.data() + 2 * n, rows.data() + 4 * n};
+    f.bodies.w = {rows.data() + n, rows.data() + 3 * n, rows.data() + 5 * n};
+    EXPECT_TRUE(f.run()) << f.run().message;
+    f.bodies.w.z = rows.data() + 4 * n + 1;  // one element into v.z
+    EXPECT_EQ(f.run().message, "bodies.v.z and bodies.w.z share memory: the solve writes both");
+  }
+  {
+    // Packed records are written whole.
+    Fixture<T> f;
+    PackedBuffer<PackedRigid<T>> rigid(f.bodies.count);
+    pack(f.bodies, packed_view(rigid));
+    PackedView<PackedRigid<T>> view = packed_view(rigid);
+    EXPECT_TRUE(message(view, f).empty());
+    view.inv_mass = &rigid[3].inv_inertia[0];
+    EXPECT_EQ(message(view, f),
+              "bodies.records and bodies.inv_mass share memory: the solve writes bodies.records while it reads "
+              "bodies.inv_mass");
+    PackedBuffer<PackedParticle<T>> particle(f.bodies.count);
+    pack(particle_view(f.bodies), packed_view(particle));
+    f.impulses.j.x = &particle[1].v[0];
+    EXPECT_EQ(message(packed_view(particle), f), "bodies.records and impulses.j.x share memory: the solve writes both");
+  }
+}
+
+TEST(ValidateDisjoint, NamesTheFirstPair) {
+  const double x[8] = {};
+  const double y[8] = {};
+  const ArrayBytes arrays[] = {{"bodies", "p", x, sizeof x, false},
+                               {"bodies", "q", x + 2, 2 * sizeof(double), false},
+                               {"solve", "out", y, sizeof y, true},
+                               {"bodies", "v", y + 7, sizeof(double), true},
+                               {"bodies", "w", nullptr, 0, true}};
+  EXPECT_TRUE(validate_disjoint(arrays, 3));
+  EXPECT_EQ(validate_disjoint(arrays, 5).message, "solve.out and bodies.v share memory: the solve writes both");
+  const ArrayBytes touching[] = {{"a", "x", x, 4 * sizeof(double), true}, {"a", "y", x + 4, 4 * sizeof(double), true}};
+  EXPECT_TRUE(validate_disjoint(touching, 2));
 }
 
 // The kernels never read a record's padding: NaN there is not an error. (A

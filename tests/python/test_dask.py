@@ -384,6 +384,21 @@ def test_solve_scenes_table(client, tmp_path):
     assert (table["momentum_drift"].abs() < 1e-5).all() and (table["angular_momentum_drift"].abs() < 1e-5).all()
 
 
+def assert_throughput_keys(stats):
+    """collisions_per_second is the kernels' throughput, as collide.solve's;
+    the call's wall time is call_seconds."""
+    assert "seconds" not in stats
+    assert stats["call_seconds"] > 0 and stats["kernel_seconds"] > 0
+    assert stats["collisions_per_second"] == stats["collisions"] / stats["kernel_seconds"]
+
+
+def test_stats_say_what_was_timed(client):
+    bodies, contacts = island_scene(seed=21)
+    stats = cd.solve((bodies, contacts), client).stats
+    assert_throughput_keys(stats)
+    assert stats["call_seconds"] >= stats["islands_seconds"]
+
+
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "collide.dask", *args], capture_output=True, text=True, timeout=120)
 
@@ -398,6 +413,7 @@ def test_the_command(client, tmp_path):
     assert r.returncode == 0, r.stderr
     stats = json.loads(r.stdout)
     assert stats["collisions"] == len(contacts) and stats["model"] == "sphere"
+    assert_throughput_keys(stats)
     assert "partitions done" in r.stderr, "a line per task when stderr is not a terminal"
     same_bytes(cd.Solution(*(np.load(tmp_path / "out" / f"{k}.npy") for k in "Jvw"), {}), expected)
 
@@ -407,6 +423,7 @@ def test_the_command(client, tmp_path):
     r = run_cli("scenes", str(spec), "--out", str(tmp_path / "t.csv"), "--workers", "1", "--sample", "500",
                 "--no-progress")
     assert r.returncode == 0, r.stderr
+    assert "Warning" not in r.stderr, "no RuntimeWarning of the cluster's processes: " + r.stderr
     lines = (tmp_path / "t.csv").read_text().splitlines()
     assert lines[0] == ",".join(cd.SCENE_COLUMNS) and len(lines) == 3
     assert lines[1].startswith("kind=pairs n=3000 seed=2,rigid,float,fast,3000,3000,1,")
@@ -566,4 +583,7 @@ def test_a_script_without_the_main_guard_runs_once(tmp_path):
     r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     assert r.stdout == "solved in 2 partitions\n", r.stdout
+    # Nothing on stderr: in particular no RuntimeWarning from runpy in the
+    # cluster's process or its workers.
+    assert "Warning" not in r.stderr, r.stderr
     assert len(runs.read_text().split()) == 1, "the script ran again in a worker: " + runs.read_text()

@@ -86,7 +86,8 @@ enum class Order {
 
 /// "input" or "colour".
 const char* to_string(Order order);
-/// Parses the names of to_string(); throws std::invalid_argument otherwise.
+/// Parses the names of to_string(); throws std::invalid_argument otherwise
+/// (for "color": "... did you mean 'colour'?").
 Order parse_order(std::string_view name);
 
 class Schedule {

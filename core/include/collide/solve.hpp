@@ -86,6 +86,12 @@ struct SolverOptions {
   int passes = 1;
 };
 
+/// The most passes the `collide` tool (--passes) and the Python module
+/// (passes=) take: a bound on a mistyped count, not a limit of the Solver.
+inline constexpr int kMaxPasses = 1000000;
+/// The most threads they take (--threads, threads=; 0 is every hardware thread).
+inline constexpr int kMaxThreads = 4096;
+
 /// What a solve did.
 struct SolveStats {
   std::size_t contacts = 0;       ///< contacts resolved (including those with J = 0)

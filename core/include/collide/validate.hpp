@@ -13,6 +13,7 @@
 // buffers apply. The normal tolerance and the quaternion rule are the same.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "collide/bodies.hpp"
@@ -31,6 +32,10 @@ struct Validation {
 /// Checks what the kernels assume:
 ///  * every non-null view has its arrays (no null pointer with count > 0);
 ///  * impulses.count == contacts.count;
+///  * no array the solve writes (v and w, the impulses; packed: the
+///    records) shares memory with another array it writes or reads, each
+///    array taken as the bytes of its `count` elements (validate_disjoint:
+///    "bodies.v.x and bodies.w.x share memory: the solve writes both");
 ///  * contact indices < bodies.count and a != b;
 ///  * inverse mass and inverse moments finite and >= 0;
 ///  * q, p, v, w, c, n finite; |n| equal to 1 within kNormalTolerance
@@ -60,6 +65,23 @@ Validation validate(const PackedView<PackedSphere<T>>& bodies, const ContactView
 template <class T>
 Validation validate(const PackedView<PackedParticle<T>>& bodies, const ContactView<T>& contacts,
                     const ImpulseView<T>& impulses);
+
+/// One array a solve touches, as the bytes it touches: [data, data + bytes).
+struct ArrayBytes {
+  const char* owner = "";  ///< what holds it: "bodies", "contacts", "impulses"
+  const char* name = "";   ///< its name there: "v.x" (a message says "bodies.v.x")
+  const void* data = nullptr;
+  std::size_t bytes = 0;
+  bool written = false;  ///< the solve writes it (and may read it)
+};
+
+/// The first two of `arrays` (in their order) whose bytes overlap where the
+/// solve writes at least one of them: "A and B share memory: the solve
+/// writes both" or "...: the solve writes B while it reads A". Arrays that
+/// are only read may share memory; null or empty arrays share nothing.
+/// validate() checks every view this way; the Python module names its
+/// arrays (one row of a 2-D array at a time) and calls it at its boundary.
+Validation validate_disjoint(const ArrayBytes* arrays, std::size_t count);
 
 /// Only what keeps a solve inside the arrays: every index of `a` and `b`
 /// below `body_count`, and a != b. O(count), for callers that vouch for the

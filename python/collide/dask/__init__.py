@@ -249,14 +249,15 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     warns with :class:`IslandWarning` when the largest island holds more than
     ``GIANT_ISLAND_SHARE`` of the contacts. ``stats``: collisions, bodies,
     islands, largest_island, largest_island_share, partitions (their contact
-    counts), model, precision, accuracy, seconds (the whole call),
-    collisions_per_second (collisions / seconds), islands_seconds,
-    kernel_seconds (the partitions' solves, summed), allocate_seconds (the
-    allocate phases of those solves, summed: each task's one-shot solver
-    grows its buffers and touches their pages before its kernels run, time
+    counts), model, precision, accuracy, call_seconds (the whole call, wall
+    time), kernel_seconds (the partitions' solves, summed),
+    collisions_per_second (collisions / kernel_seconds: the kernels'
+    throughput, as collide.solve reports it), allocate_seconds (the allocate
+    phases of those solves, summed: each task's one-shot solver grows its
+    buffers and touches their pages before its kernels run, time
     kernel_seconds leaves out), partition_seconds (each partition's task on
-    its worker, read to write), and for files
-    read_seconds (the load and check on the client)."""
+    its worker, read to write), islands_seconds, and for files read_seconds
+    (the load and check on the client) and outputs (the three paths)."""
     started = time.perf_counter()
     options = _options(model, accuracy, threads, isa)
     if _is_scene_files(scene):
@@ -279,13 +280,16 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
 
 
 def _stats(scene_model, precision, collisions, body_count, figures, counts, options, results, started, **extra):
-    """The stats of a distributed solve (see :func:`solve`)."""
-    seconds = time.perf_counter() - started
+    """The stats of a distributed solve (see :func:`solve`): as in
+    collide.solve's, collisions_per_second is the kernels' throughput,
+    collisions / kernel_seconds; the whole call's wall time is
+    call_seconds."""
+    kernel_seconds = sum(r["kernel_seconds"] for r in results)
     return {"collisions": collisions, "bodies": body_count, **figures, "partitions": [int(c) for c in counts if c],
             "model": scene_model, "precision": "float" if precision == np.float32 else "double",
-            "accuracy": options["accuracy"], "seconds": seconds,
-            "collisions_per_second": collisions / seconds if seconds > 0 else 0.0,
-            "kernel_seconds": sum(r["kernel_seconds"] for r in results),
+            "accuracy": options["accuracy"], "call_seconds": time.perf_counter() - started,
+            "kernel_seconds": kernel_seconds,
+            "collisions_per_second": collisions / kernel_seconds if kernel_seconds > 0 else 0.0,
             "allocate_seconds": sum(r["allocate_seconds"] for r in results),
             "partition_seconds": [r["seconds"] for r in results], **extra}
 

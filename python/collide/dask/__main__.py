@@ -88,6 +88,7 @@ def _scene_entries(inputs):
 
 def _write_atomically(path, text):
     directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)  # as every writer of collide creates a missing directory
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=".collide-dask-")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
@@ -156,6 +157,23 @@ Scene<T> generate_chain(std::size_t contacts, const GenerateOptions& options = {
 /// The longest chain: contacts + 1 boxes have 32-bit ids (2^32 - 2 contacts,
 /// the most a Schedule takes).
 inline constexpr std::size_t kMaxChainContacts = (std::size_t{1} << 32) - 2;
+
+/// The most pairs: 2N bodies have 32-bit ids.
+inline constexpr std::size_t kMaxPairs = 0x7FFFFFFF;
+/// The most debris contacts: N / 2 + 1 bodies have 32-bit ids.
+inline constexpr std::size_t kMaxDebrisContacts = 0xFFFFFFFF;
+
+/// The largest count of scene `kind` ("pairs", "debris", "pile" or "chain";
+/// 0 for another) that `collide gen --<kind> N` and collide.generate(kind,
+/// n) take: kMaxPairs, kMaxDebrisContacts, kMaxPileSide (boxes per side)
+/// and kMaxChainContacts. The least is 1 for every scene: no scene is empty.
+inline std::size_t max_scene_count(std::string_view kind) {
+  return kind == "pairs"    ? kMaxPairs
+         : kind == "debris" ? kMaxDebrisContacts
+         : kind == "pile"   ? kMaxPileSide
+         : kind == "chain"  ? kMaxChainContacts
+                            : 0;
+}
 
 // The pieces of the chain scene, each a pure function of its arguments, so
 // that a chain can be written in a stream.

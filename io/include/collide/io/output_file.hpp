@@ -6,7 +6,10 @@
 //   hidden temporary name in the destination's directory and renamed onto
 //   the destination by commit(): a failure, or an OutputFile destroyed
 //   without commit, leaves the destination untouched, and a reader never
-//   sees half a file.
+//   sees half a file. A missing directory (and its missing parents) is
+//   created first, for every writer alike (`collide solve --out-bodies
+//   new/ob.csv`, `collide gen --out new`, `collide.save("new/b.npz", ...)`);
+//   it stays if the output is then not committed.
 // * A path that exists and is not a regular file - a character device such
 //   as /dev/null, a FIFO, a socket - is opened and written directly. Renaming
 //   over it would replace the node itself (as root, `--out-impulses
@@ -34,8 +37,9 @@ namespace collide {
 /// The path that names the standard output.
 inline constexpr std::string_view kStdoutPath = "-";
 
-/// A result file: written under a temporary name next to `path` and renamed
-/// onto `path` by commit() when `path` is a regular file or does not exist;
+/// A result file: written under a temporary name next to `path` (its
+/// directory created when missing) and renamed onto `path` by commit() when
+/// `path` is a regular file or does not exist;
 /// written directly when `path` is "-" (stdout) or an existing non-regular
 /// file (device, FIFO, socket). Destroyed without commit, a renamed output
 /// removes its temporary and leaves `path` as it was. Not copyable; movable.
