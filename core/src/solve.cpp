@@ -18,12 +18,13 @@
 // * Nothing here allocates once the packing and prepared buffers are sized: the Solver owns
 //   its task_arena (or borrows the caller's, collide/tbb.hpp), the Schedule
 //   owns the order.
-// * The allocate phase: a solve sizes the buffers it uses (the packed
-//   records, the prepared contacts) before it packs or copies anything, and
-//   has the pages of what grew touched by the arena's threads
-//   (first_touch.hpp), so the faults of a fresh Solver's first solve are
-//   paid there, timed as SolveStats::allocate_seconds, and not by the passes
-//   that follow. A solve that finds its buffers sized reports 0.
+// * The allocate phase: a solve sizes each buffer it uses before the pass
+//   that fills it (the packed records before packing, the prepared contacts
+//   before their copy) and has the pages of what grew touched by the arena's
+//   threads (first_touch.hpp), so the faults of a fresh Solver's first solve
+//   are paid there, timed (both parts summed) as
+//   SolveStats::allocate_seconds, and not by the passes. A solve that finds
+//   its buffers sized reports 0.
 #include <cassert>
 #include <chrono>
 #include <mutex>
