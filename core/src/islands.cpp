@@ -30,7 +30,7 @@
 // Memory: the arrays are allocated uninitialised (LabelAllocator) in 2 MiB
 // pages; each pass writes what a later one reads, so the pages are first
 // touched in parallel by the pass that fills them, rather than zeroed first
-// on one thread (docs/decisions/0023).
+// on one thread (docs/decisions/0023-fresh-arrays-touched-where-they-are-written.md).
 //
 // The atomics are std::atomic_ref (C++20) over plain vectors, relaxed: the
 // union-find's correctness rests on the compare-and-swap alone, and every

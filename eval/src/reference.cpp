@@ -182,7 +182,7 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
   // its relative velocity off by that much on top of its own rounding. This
   // keeps the bound C eps s a statement about every contact of a chain, not
   // only about the first one: without it, contacts deep in the debris
-  // scene's chains exceeded the bound (docs/decisions/0008).
+  // scene's chains exceeded the bound (docs/decisions/0008-the-impulse-scale.md).
   std::vector<S> inherited_v(kErrorAnalysis ? bodies.count : 0, S(0));
   std::vector<S> inherited_w(kErrorAnalysis ? bodies.count : 0, S(0));
   for (std::size_t step = 0; step < sequence.passes * contacts.count; ++step) {
@@ -306,7 +306,7 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
           // Without it, a debris contact with a long lever arm on a body of
           // unequal moments exceeded the bound in reference_solve<double>
           // (docs/collision-law.md, "The friction step after the normal
-          // impulse"; docs/decisions/0008).
+          // impulse"; docs/decisions/0008-the-impulse-scale.md).
           if constexpr (kErrorAnalysis) {
             const S own_after = own_speed_scale();
             auto with_friction = [&](S normal_scale, S before, S after) {

@@ -440,9 +440,14 @@ TEST_F(OutputFileTest, SceneWritersMatchTheRowFormatters) {
   expect_writers_match_row_formatters<double>(dir_);
 }
 
-TEST_F(OutputFileTest, MissingDirectoryIsASceneError) {
-  EXPECT_THROW(collide::OutputFile((dir_ / "no" / "out.csv").string()), SceneError);
+// Every writer creates the folders its path names (docs/cli.md); a path that
+// is a folder, or runs through a file, is refused.
+TEST_F(OutputFileTest, MissingFoldersAreCreatedAndAFolderOrAFileInTheWayIsASceneError) {
+  EXPECT_NO_THROW(collide::OutputFile((dir_ / "no" / "out.csv").string()));
+  EXPECT_TRUE(std::filesystem::is_directory(dir_ / "no"));
   EXPECT_THROW(collide::OutputFile(dir_.string()), SceneError);
+  std::ofstream(dir_ / "file") << "x";
+  EXPECT_THROW(collide::OutputFile((dir_ / "file" / "out.csv").string()), SceneError);
 }
 
 }  // namespace

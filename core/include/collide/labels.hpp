@@ -21,8 +21,8 @@ namespace collide {
 /// The allocator of Labels: std::allocator's, except that resize() leaves
 /// the new values uninitialised (their owner writes every one, in parallel
 /// passes; a std::vector would first zero them on one thread:
-/// docs/decisions/0023), on LargeAllocator's memory (huge pages from 2 MiB
-/// on).
+/// docs/decisions/0023-fresh-arrays-touched-where-they-are-written.md), on LargeAllocator's memory (huge pages from 2
+/// MiB on).
 struct LabelAllocator {
   using value_type = std::uint32_t;
   template <class U>
