@@ -115,7 +115,7 @@ double time_iterations(
 struct Columns {
   double items = 0;           ///< per iteration: collisions, contacts scheduled, triad elements
   double bytes_per_item = 0;  ///< law bytes per collision (12 for the triad)
-  double seconds = 0;         ///< median time of one iteration (time_iterations)
+  double seconds = 0;         ///< one iteration: the median (time_iterations); the triad's best pass
   int threads = 1;            ///< for the bandwidth bound
   double batches = 0;         ///< schedule batches
   double schedule_bytes_per_contact = 0;

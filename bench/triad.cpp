@@ -8,9 +8,11 @@
 // one contiguous slice per thread, first-touched with the same slicing), the
 // same one `collide report` takes its bound from. Here Google Benchmark times
 // its passes (the rule of collide/eval/timing.hpp: one more untimed pass,
-// then timed ones); the row's rate is the median pass, and the best pass,
-// the bound as collide::measure_triad and the report take it, is published
-// through set_triad_gbs() for the bw_frac column of every later row.
+// then timed ones). The figure is the best pass, not the median: the bound,
+// what the memory system can do (STREAM's convention, and how
+// collide::measure_triad and the report take it). It is the row's counters
+// and is published through set_triad_gbs() for the bw_frac column of every
+// later row.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -36,7 +38,7 @@ void triad_benchmark(benchmark::State& state, int threads) {
   Columns columns;
   columns.items = static_cast<double>(triad.elements());
   columns.bytes_per_item = 12;
-  columns.seconds = series.median();
+  columns.seconds = best;
   columns.threads = threads;
   set_counters(state, columns);
 }
