@@ -11,6 +11,13 @@
 //   --scene=B,C      also the rows of one group on the scene in the files B
 //                    (bodies) and C (contacts), CSV or binary (.npz) by name,
 //                    named solve/file/..., schedule/file/... (N: its contacts)
+//   --timing-check   no rows: every instrument times the same solve and the
+//                    figures must agree (timing_check.hpp); with
+//                    --collide=PATH (default: collide beside collide_bench),
+//                    --timing-dir=DIR (scene files; default a temporary one),
+//                    --timing-scenes=KIND:N,... (default pairs:1e6,pairs:4e6,
+//                    debris:1e6,pile:2980000), --timing-runs=R (3),
+//                    --timing-tolerance=F (0.1). Exit 1 when they disagree.
 // Any --benchmark_filter gets "|^triad/" appended so that the bound is always
 // measured. The console table is tabular unless --benchmark_counters_tabular=
 // false is given; --benchmark_min_time defaults to 0.2 (seconds). With a
@@ -35,6 +42,7 @@
 #include "scenes.hpp"
 #include "summary.hpp"
 #include "support.hpp"
+#include "timing_check.hpp"
 
 namespace collide_bench {
 namespace {
@@ -56,6 +64,39 @@ Options parse_own_flags(int& argc, char** argv) {
       }
       options.scene_bodies = files.substr(0, comma);
       options.scene_contacts = files.substr(comma + 1);
+    } else if (arg == "--timing-check") {
+      options.timing.enabled = true;
+    } else if (arg.rfind("--collide=", 0) == 0) {
+      options.timing.collide = arg.substr(10);
+    } else if (arg.rfind("--timing-dir=", 0) == 0) {
+      options.timing.dir = arg.substr(13);
+    } else if (arg.rfind("--timing-runs=", 0) == 0) {
+      options.timing.runs = std::atoi(arg.c_str() + 14);
+      if (options.timing.runs < 1 || options.timing.runs > 1000) {
+        std::fprintf(stderr, "collide_bench: --timing-runs must be from 1 to 1000, got '%s'\n", arg.c_str() + 14);
+        std::exit(2);
+      }
+    } else if (arg.rfind("--timing-tolerance=", 0) == 0) {
+      options.timing.tolerance = std::atof(arg.c_str() + 19);
+      if (!(options.timing.tolerance > 0)) {
+        std::fprintf(stderr, "collide_bench: --timing-tolerance must be above 0, got '%s'\n", arg.c_str() + 19);
+        std::exit(2);
+      }
+    } else if (arg.rfind("--timing-scenes=", 0) == 0) {
+      options.timing.scenes.clear();
+      std::stringstream list(arg.substr(16));
+      std::string item;
+      while (std::getline(list, item, ',')) {
+        const std::size_t colon = item.find(':');
+        const std::string kind = item.substr(0, colon);
+        const double n = colon == std::string::npos ? 0 : std::atof(item.c_str() + colon + 1);
+        if ((kind != "pairs" && kind != "debris" && kind != "pile") || !(n >= 1 && n <= 2147483647.0)) {
+          std::fprintf(stderr, "collide_bench: --timing-scenes takes pairs:N, debris:N or pile:N, got '%s'\n",
+                       item.c_str());
+          std::exit(2);
+        }
+        options.timing.scenes.emplace_back(kind, static_cast<std::size_t>(n));
+      }
     } else if (arg.rfind("--sizes=", 0) == 0) {
       options.sizes.clear();
       std::stringstream list(arg.substr(8));
@@ -110,6 +151,9 @@ int main(int argc, char** argv) {
   }
 
   std::ostream& info = options.console ? std::cout : std::cerr;
+  if (options.timing.enabled) {
+    return run_timing_check(options.timing, info);
+  }
   // Listing the rows needs no check. (Looked up before Initialize, which
   // removes the flags it knows from argv.)
   const bool checks_ok = listing || check_kernels(info);

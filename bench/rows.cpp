@@ -4,14 +4,23 @@
 //
 // Design notes
 // ------------
-// * Only the solve itself is timed. Before every timed solve the scene is
-//   reset untimed (Prepared::reset_for_solve: the pristine velocities back,
-//   and a cold cache for a scene larger than the LLC), so every solve starts
-//   from the same state.
+// * Every row is timed by the rule of collide/eval/timing.hpp, the one
+//   `collide report` follows for its rows and its N sweep (time_iterations,
+//   support.hpp, drives collide::RunSeries inside Google Benchmark's loop):
+//   one untimed warm-up solve before the loop, whatever the scene's size
+//   (worker threads started, the solver's buffers sized and first touched);
+//   before every solve, the warm-up's included, the scene is reset untimed
+//   (Prepared::reset_for_solve: the pristine velocities back); only the
+//   solve itself is timed; the row's figure is the median iteration.
+//   Google Benchmark keeps its own loop, which decides how many iterations
+//   run; the warm-up, the reset and the median are the shared rule.
+// * What differs on purpose: for a scene larger than the LLC the reset also
+//   streams the caches (scenes.hpp), so each solve starts cold, as a large
+//   scene starts every frame; `collide report` does not, and such a row's
+//   label ends in "cold caches". The twin rows (twin/, order_twin/) time
+//   the memory traffic of a solve without its law (label "memory only").
 // * The Schedule is built once per scene (untimed, it is reusable) and a
-//   Solver once per row; for a scene that fits in the LLC one untimed solve
-//   before the loop starts the worker threads. Schedule::build has its own
-//   rows.
+//   Solver once per row. Schedule::build has its own rows.
 // * Isa::automatic measures the ISAs at the first solve of each kind in a
 //   process; every row asks for that measurement before its timed loop, so
 //   that no row times the one-off cost.
@@ -36,25 +45,27 @@ namespace {
 
 using collide::Path;
 
-/// Times `solve_once` with the scene reset before each call (untimed), and
-/// `reset` after the scene's reset (untimed too).
+/// Times `solve_once` by the rule (time_iterations): an untimed warm-up
+/// solve, then the iterations, each solve after the scene's reset and then
+/// `reset` (both untimed, the warm-up's too). Returns the median iteration.
 template <class T, class F, class R = void (*)()>
 double timed_solves(
     benchmark::State& state, Prepared<T>& p, F&& solve_once, R&& reset = [] {}) {
-  // Warm-up, for a scene that fits in the LLC: worker threads started, code
-  // and data in cache. A larger scene starts cold anyway, and one more solve
-  // of it would cost seconds for a thread start-up of microseconds.
-  if (!p.exceeds_llc) {
-    p.reset_for_solve();
-    reset();
-    solve_once();
-  }
   const double seconds = time_iterations(state, solve_once, [&] {
     p.reset_for_solve();
     reset();
   });
   p.restore();
   return seconds;
+}
+
+/// What a row's label adds when its solves start from cold caches (a scene
+/// larger than the LLC, scenes.hpp): ", cold caches" after `label`, or
+/// "cold caches" alone; `label` unchanged otherwise.
+template <class T>
+std::string cache_label(const Prepared<T>& p, std::string label) {
+  if (!p.exceeds_llc) return label;
+  return label.empty() ? "cold caches" : label + ", cold caches";
 }
 
 /// Runs collide::fastest_isa's measurement for the model's solves, pairs and
@@ -118,10 +129,8 @@ double layout_solve(benchmark::State& state, Prepared<T>& p, const collide::Solv
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
   if (layout != LayoutRow::records) {
-    // One untimed solve sizes the solver's buffers (packing, ordered
-    // contacts): a frame loop pays that once, not per frame.
-    p.reset_for_solve();
-    solver.solve(model, bodies, contacts, impulses, p.schedule);
+    // The warm-up sizes the solver's buffers (packing, ordered contacts): a
+    // frame loop pays that once, not per frame.
     return timed_solves(state, p, [&] { stats = solver.solve(model, bodies, contacts, impulses, p.schedule); });
   }
   collide::PackedBuffer<Record> records(bodies.count);
@@ -140,7 +149,7 @@ double packed_twin_solves(benchmark::State& state, Prepared<T>& p, int threads, 
   pack_as(p.bodies(), collide::packed_view(records));
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
-  packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule);  // sizes its buffers
+  // The warm-up sizes the twin's buffers.
   return timed_solves(state, p,
                       [&] { packed_twin_pass(arena, collide::packed_view(records), contacts, impulses, schedule); });
 }
@@ -166,8 +175,8 @@ void solve_row(benchmark::State& state, Kind kind, std::size_t n, Path path, int
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(std::string(path == Path::simd ? collide::to_string(stats.isa) : "scalar") + ", " +
-                 std::to_string(stats.lanes) + " lanes");
+  state.SetLabel(cache_label(p, std::string(path == Path::simd ? collide::to_string(stats.isa) : "scalar") + ", " +
+                                    std::to_string(stats.lanes) + " lanes"));
 }
 
 // Through the Model-dispatching Solver::solve: the views of the smaller
@@ -198,7 +207,7 @@ void model_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(p.schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(model_label(stats));
+  state.SetLabel(cache_label(p, model_label(stats)));
 }
 
 template <class T>
@@ -217,7 +226,7 @@ void layout_row(benchmark::State& state, Kind kind, std::size_t n, collide::Mode
   Columns columns = solve_columns(n, collide::bytes_per_collision(model, sizeof(T), p.friction), seconds, threads);
   columns.batches = static_cast<double>(stats.batches);
   set_counters(state, columns);
-  state.SetLabel(model_label(stats));
+  state.SetLabel(cache_label(p, model_label(stats)));
 }
 
 // On the scene of the model rows: the ceiling of the model's data layout, in
@@ -233,7 +242,7 @@ void twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::Model 
   const double seconds = timed_solves(state, p, [&] { memory_twin_pass<T>(model, arena, bodies, contacts, impulses); });
 
   set_counters(state, solve_columns(n, collide::bytes_per_collision(model, sizeof(T), p.friction), seconds, threads));
-  state.SetLabel("memory only");
+  state.SetLabel(cache_label(p, "memory only"));
 }
 
 // On the scene of the layout rows: the ceiling of the layout/.../records
@@ -244,7 +253,7 @@ void packed_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide:
   const double seconds = with_record<T>(
       model, [&](auto record) { return packed_twin_solves<T, decltype(record)>(state, p, threads, p.schedule); });
   set_counters(state, solve_columns(n, collide::bytes_per_collision(model, sizeof(T), false), seconds, threads));
-  state.SetLabel("memory only, packed");
+  state.SetLabel(cache_label(p, "memory only, packed"));
 }
 
 template <class T>
@@ -256,6 +265,7 @@ void textbook_row(benchmark::State& state, Kind kind, std::size_t n) {
   const double seconds = timed_solves(state, p, [&] { textbook_solve(bodies, contacts, impulses); });
 
   set_counters(state, solve_columns(n, bytes_per_collision<T>(p.friction), seconds, 1));
+  state.SetLabel(cache_label(p, ""));
 }
 
 template <class T>
@@ -263,10 +273,9 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
   Prepared<T>& p = prepared_scene<T>(kind, n);
   const collide::BodyView<T> bodies = p.bodies();
   const collide::ContactView<T> contacts = p.contacts();
-  // A schedule of its own, built once untimed: later builds reuse its buffers,
-  // as a simulation that rebuilds every frame does.
+  // A schedule of its own; the warm-up builds it once untimed, and later
+  // builds reuse its buffers, as a simulation that rebuilds every frame does.
   collide::Schedule schedule(order);
-  schedule.build(contacts, bodies);
   const double seconds = time_iterations(state, [&] { schedule.build(contacts, bodies); });
   Columns columns;
   columns.items = static_cast<double>(n);
@@ -290,9 +299,7 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
   schedule.build(contacts, bodies, threads);
-  // One untimed solve sizes the solver's buffers (packing), as a frame loop's first frame does.
-  p.reset_for_solve();
-  solver.solve(bodies, contacts, impulses, schedule);
+  // The warm-up sizes the solver's buffers (packing), as a frame loop's first frame does.
   collide::SolveStats stats;
   const double seconds = timed_solves(state, p, [&] { stats = solver.solve(bodies, contacts, impulses, schedule); });
   Columns columns =
@@ -300,8 +307,9 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) + ", " +
-                 std::to_string(stats.colours) + " colours, " + std::to_string(stats.overflow_contacts) + " overflow");
+  state.SetLabel(cache_label(p, std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) +
+                                    ", " + std::to_string(stats.colours) + " colours, " +
+                                    std::to_string(stats.overflow_contacts) + " overflow"));
 }
 
 /// The packed twin (packed_twin.hpp: every byte the solve reads and writes,
@@ -316,6 +324,7 @@ void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::
   Columns columns = solve_columns(n, bytes_per_collision<T>(p.friction), seconds, threads);
   columns.batches = static_cast<double>(schedule.batch_count());
   set_counters(state, columns);
+  state.SetLabel(cache_label(p, "memory only, packed"));
 }
 
 #define COLLIDE_BENCH_ROWS(T)                                                                                     \

@@ -28,8 +28,9 @@
 //   the restore, which would leave up to an LLC of dirty velocity lines for
 //   the timed solve to write back and a tail of warm lines, 4x the LLC is
 //   streamed through the caches (untimed), as a large scene starts every
-//   frame. A scene that fits in the LLC is solved warm, which is what it would
-//   be.
+//   frame; the rows' label says "cold caches", since `collide report` does
+//   not stream them. A scene that fits in the LLC is solved warm, which is
+//   what it would be.
 // * Memory: when a scene is prepared, its buffers are generated, the peak RSS
 //   is reset (/proc/self/clear_refs), the schedule is built and one 2-thread
 //   SIMD solve runs; the growth of the peak over the RSS before is what the

@@ -91,16 +91,14 @@ void set_triad_gbs(int threads, double gbs) {
 
 void set_counters(benchmark::State& state, const Columns& c) {
   using benchmark::Counter;
-  const double iterations = static_cast<double>(state.iterations());
   const double seconds = c.seconds > 0 ? c.seconds : 1e-300;
-  const double gbs = c.items * c.bytes_per_item * iterations / seconds / 1e9;
-  const double bound = triad_gbs(c.threads);
-  // Rates are computed here from the time the benchmark measured itself (the
-  // manual time that Google Benchmark also reports), so that the file
-  // reporter, which gets the same counters, agrees with the console.
-  state.counters["coll/s"] = Counter(c.items * iterations / seconds);
-  state.counters["GB/s"] = Counter(gbs);
-  state.counters["bw_frac"] = Counter(bound > 0 && c.bytes_per_item > 0 ? gbs / bound : 0.0);
+  const double rate = c.items / seconds;
+  // Rates are computed here from the median iteration the row measured
+  // itself (support.hpp), so that the file reporter, which gets the same
+  // counters, agrees with the console.
+  state.counters["coll/s"] = Counter(rate);
+  state.counters["GB/s"] = Counter(rate * c.bytes_per_item / 1e9);
+  state.counters["bw_frac"] = Counter(collide::bandwidth_fraction(rate, c.bytes_per_item, triad_gbs(c.threads) * 1e9));
   state.counters["B/coll"] = Counter(c.bytes_per_item);
   state.counters["batches"] = Counter(c.batches);
   state.counters["sched_B/c"] = Counter(c.schedule_bytes_per_contact);

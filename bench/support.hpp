@@ -15,42 +15,43 @@
 //   those bytes at the triad's rate is at 100% of the bandwidth bound; a
 //   debris scene, whose bodies are shared, may beat 100% because the same body
 //   is counted once per contact but fetched from cache the second time.
-// * The triad benchmarks run first and publish their bandwidth here, so every
-//   later row can report its fraction of the bound measured on the same
-//   machine, in the same process, a few seconds earlier.
+// * The triad benchmarks run first and publish their bandwidth here (the
+//   best pass, the bound as collide report and collide::measure_triad take
+//   it), so every later row can report its fraction of the bound measured on
+//   the same machine, in the same process, a few seconds earlier.
 // * Every row of the table has the same counters (see Columns), so the
 //   tabular console output prints one header for the whole run; a column that
 //   does not apply to a row is 0: coll/s = collisions per second (contacts
 //   scheduled per second on schedule rows, elements per second on triad
-//   rows); GB/s = coll/s x B/coll; bw_frac = GB/s / triad GB/s at the same
-//   thread count; B/coll = bytes of the law's inputs and outputs per
+//   rows), n over the median iteration time; GB/s = coll/s x B/coll; bw_frac
+//   = collide::bandwidth_fraction (collide/eval/timing.hpp): GB/s over the
+//   triad's GB/s at the same thread count; B/coll = bytes of the law's inputs and outputs per
 //   collision; batches = schedule batches; sched_B/c =
 //   Schedule::memory_bytes() / contacts; peak_MiB = VmHWM.
-// * Rows time themselves (UseManualTime): steady_clock around the one timed
-//   call of an iteration, whatever untimed work precedes it. Reading the
-//   clock costs tens of nanoseconds against at least tens of microseconds for
-//   the smallest solve, and unlike PauseTiming/ResumeTiming it does not
-//   distort small N. The CPU column of Google Benchmark is the main thread's
-//   CPU time over the whole loop, untimed work included: read the Time column
-//   (the manual time).
+// * Rows time themselves (UseManualTime) by the rule of
+//   collide/eval/timing.hpp, the one `collide report` follows: one untimed
+//   warm-up run before the loop, then per iteration the untimed work (the
+//   scene's reset) and the one timed call with steady_clock around it alone;
+//   the row's figure is the median iteration. Google Benchmark decides how
+//   many iterations there are (--benchmark_min_time) and its Time column is
+//   their mean; the counters (coll/s, GB/s, bw_frac) are from the median,
+//   like every figure of the report. Reading the clock costs tens of
+//   nanoseconds against at least tens of microseconds for the smallest
+//   solve, and unlike PauseTiming/ResumeTiming it does not distort small N.
+//   The CPU column of Google Benchmark is the main thread's CPU time over the
+//   whole loop, untimed work included: read the counters or the Time column.
 #pragma once
 
 #include <benchmark/benchmark.h>
 
-#include <chrono>
 #include <cstddef>
 #include <string>
 
 #include "collide/contacts.hpp"
+#include "collide/eval/timing.hpp"
 #include "collide/eval/traffic.hpp"
 
 namespace collide_bench {
-
-using Clock = std::chrono::steady_clock;
-
-inline double seconds_between(Clock::time_point t0, Clock::time_point t1) {
-  return std::chrono::duration<double>(t1 - t0).count();
-}
 
 /// Bytes of the rigid law's inputs and outputs for one contact, each counted
 /// once (232 for float without friction, 456 for double).
@@ -91,31 +92,30 @@ void set_triad_gbs(int threads, double gbs);
 /// Registers triad/t:1 and triad/t:2. Must come before every other row.
 void register_triad();
 
-/// The benchmark loop of a row: per iteration `untimed()` (nothing by
-/// default), then `timed()` with steady_clock around it alone, reported as
-/// the iteration's manual time. Returns the measured time of all iterations
-/// together.
+/// The benchmark loop of a row, by the rule of collide/eval/timing.hpp
+/// (collide::RunSeries): `untimed()` (nothing by default) and `timed()` once
+/// before the loop, the warm-up, not timed; then per iteration `untimed()`
+/// and `timed()` with steady_clock around it alone, reported as the
+/// iteration's manual time. Returns the median iteration time, the row's
+/// figure (Columns::seconds).
 template <class Timed, class Untimed = void (*)()>
 double time_iterations(
     benchmark::State& state, Timed&& timed, Untimed&& untimed = [] {}) {
-  double seconds = 0;
-  for (auto _ : state) {
-    untimed();
-    const auto t0 = Clock::now();
-    timed();
-    const auto t1 = Clock::now();
-    const double s = seconds_between(t0, t1);
-    state.SetIterationTime(s);
-    seconds += s;
-  }
-  return seconds;
+  collide::RunSeries series(
+      [&] {
+        untimed();
+        timed();
+      },
+      [&] { return collide::timed_run(untimed, timed); });
+  for (auto _ : state) state.SetIterationTime(series.next());
+  return series.median();
 }
 
 /// The counters of every row (see the design notes above).
 struct Columns {
   double items = 0;           ///< per iteration: collisions, contacts scheduled, triad elements
   double bytes_per_item = 0;  ///< law bytes per collision (12 for the triad)
-  double seconds = 0;         ///< measured time of all iterations together
+  double seconds = 0;         ///< one iteration: the median (time_iterations); the triad's best pass
   int threads = 1;            ///< for the bandwidth bound
   double batches = 0;         ///< schedule batches
   double schedule_bytes_per_contact = 0;

@@ -24,7 +24,10 @@
 //   reused objects: loading a chunk (masses, inertia, transform, velocities,
 //   the manifold point) is untimed, like the velocity restore of the kernel
 //   rows, and only solveGroup is timed: Bullet's own setup (solver bodies,
-//   constraint rows), its iteration and its write-back. A chunk's objects
+//   constraint rows), its iteration and its write-back. A run's time is the
+//   sum of its chunks' solveGroup times, and the runs follow the rule of
+//   collide/eval/timing.hpp (measure_runs): one untimed warm-up run, then
+//   `runs` timed runs, their median. A chunk's objects
 //   (over 600 MB) are far larger than the last-level cache, so a chunk comes
 //   from memory as the kernel's scene does.
 // * Bullet here is the Debian build: btScalar is float (no
@@ -41,6 +44,7 @@
 #include <utility>
 #include <vector>
 
+#include "collide/eval/timing.hpp"
 #include "collide/eval/traffic.hpp"
 #include "measure.hpp"
 
@@ -184,21 +188,21 @@ ReportRow bullet_row(const Scene<float>& scene, std::size_t n, const Scene<float
   row.n = n;
   row.note = bullet_version() + ", solveGroup per " + std::to_string(kChunkPairs) + " pairs";
   if (n != scene.contacts.size()) row.note = "first " + std::to_string(n) + " contacts; " + row.note;
-  std::vector<double> seconds;
-  for (int r = 0; r < runs; ++r) {
+  // One run: every chunk loaded (untimed) and solved (timed).
+  const RunTimes times = measure_runs(RunPlan::fixed(runs), [&] {
     double total = 0;
     for (std::size_t first = 0; first < n; first += kChunkPairs) {
       peer.load(scene, first, std::min(kChunkPairs, n - first));
       total += peer.solve();
     }
-    seconds.push_back(total);
-  }
-  row.runs = runs;
-  row.seconds = median(std::move(seconds));
+    return total;
+  });
+  row.runs = times.runs();
+  row.seconds = times.median;
   row.collisions_per_second = row.seconds > 0 ? static_cast<double>(n) / row.seconds : 0;
   row.bytes_per_collision = static_cast<double>(bytes_per_collision(Model::rigid, sizeof(float), false));
   row.bandwidth_fraction =
-      triad_bytes_per_second > 0 ? row.collisions_per_second * row.bytes_per_collision / triad_bytes_per_second : 0;
+      bandwidth_fraction(row.collisions_per_second, Model::rigid, sizeof(float), false, triad_bytes_per_second);
 
   // The error sample, through the same chunks.
   BodyBuffer<float> after = sample.bodies;

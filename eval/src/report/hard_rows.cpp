@@ -10,10 +10,11 @@
 //   default, as the tests), the shared scenes at their fixed sizes.
 // * Speed: the SIMD path at one thread on the default ISA (the shared
 //   scenes are chains, a batch per link, so threads would measure the
-//   schedule's barriers, not the arithmetic). Each run restores the stored
-//   velocities untimed and times the solve alone; the runs are as many as
-//   fit about 20 ms, at least `runs` and at most 1000 (a hard scene of 1000
-//   contacts solves in microseconds); the median is reported.
+//   schedule's barriers, not the arithmetic). The rule of
+//   collide/eval/timing.hpp: one untimed warm-up solve, then timed solves,
+//   each after an untimed restore of the stored bodies; the timed runs are
+//   as many as fit about 20 ms, at least `runs` and at most 1000 (a hard
+//   scene of 1000 contacts solves in microseconds); the median is reported.
 // * Error, two units per row, for both modes:
 //   - max_err_eps: |J - Jref| in the fast mode's unit, eps(T) times the
 //     contact's impulse scale (error_bound.hpp), against
@@ -34,7 +35,6 @@
 //     rounding of the state a chain stores (docs/collision-law.md,
 //     "Accuracy modes").
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -45,6 +45,7 @@
 #include "collide/eval/error_bound.hpp"
 #include "collide/eval/hard_scenes.hpp"
 #include "collide/eval/reference.hpp"
+#include "collide/eval/timing.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/isa.hpp"
 #include "collide/schedule.hpp"
@@ -55,7 +56,6 @@ namespace collide::report_detail {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using L = long double;
 
 /// The reference that judges the plain relative error of T.
@@ -162,20 +162,14 @@ void measure_scene(const hard::HardScene& hs, const ReportOptions& options, std:
 
     BodyBuffer<T> bodies = scene.bodies;
     ImpulseBuffer<T> j(scene.contacts.size());
-    std::vector<double> seconds;
-    double total = 0;
     SolveStats stats;
-    while (seconds.size() < 1000 && (seconds.size() < static_cast<std::size_t>(options.runs) || total < 0.02)) {
-      bodies = scene.bodies;  // untimed restore
-      const auto t0 = Clock::now();
-      stats = solver.solve(hs.fit, bodies.view(), scene.contacts.view(), j.view(), schedule);
-      seconds.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
-      total += seconds.back();
-    }
+    const RunTimes times = time_solve(
+        RunPlan{options.runs, 0.02, 1000}, [&] { bodies = scene.bodies; },
+        [&] { stats = solver.solve(hs.fit, bodies.view(), scene.contacts.view(), j.view(), schedule); });
     row.threads = 1;
     row.isa = to_string(stats.isa);
-    row.runs = static_cast<int>(seconds.size());
-    row.seconds = median(std::move(seconds));
+    row.runs = times.runs();
+    row.seconds = times.median;
     row.collisions_per_second = row.seconds > 0 ? static_cast<double>(row.n) / row.seconds : 0;
 
     ReportRow errors;

@@ -1,5 +1,5 @@
 // report/measure.cpp - what the rows of the report share: error against the
-// long double reference, momentum and energy totals, the median of run times.
+// long double reference, momentum and energy totals.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -23,14 +23,6 @@ using L = long double;
 // ---------------------------------------------------------------------------
 // Error against the reference.
 // ---------------------------------------------------------------------------
-
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  if (values.size() % 2 == 1) return *mid;
-  return 0.5 * (*mid + *std::max_element(values.begin(), mid));
-}
 
 template <class T>
 ReferenceResult reference_of(const Scene<T>& sample, const std::uint32_t* order) {

@@ -39,9 +39,6 @@ template <class T>
 void fill_error(ReportRow& row, const ImpulseView<const T>& impulses, const BodyView<const T>& after,
                 const ReferenceResult& reference, double eps);
 
-/// Median of a list of run times.
-double median(std::vector<double> values);
-
 // ---------------------------------------------------------------------------
 // The hard section (hard_rows.cpp).
 // ---------------------------------------------------------------------------

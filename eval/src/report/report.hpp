@@ -8,7 +8,8 @@
 // Design notes
 // ------------
 // * One Row is one variant measured on one scene: speed (median of timed
-//   runs of the solve alone) and error (against reference_solve<long double>
+//   runs of the solve alone after an untimed warm-up, the rule of
+//   collide/eval/timing.hpp) and error (against reference_solve<long double>
 //   on an error sample). The same struct feeds the table, the JSON and the
 //   plot, so the three can never disagree.
 // * The peer (Bullet) lives in its own translation unit behind
@@ -46,7 +47,7 @@ struct ReportRow {
   /// pile's rows in the colour order, whose error is against the reference
   /// replaying that order.
   std::string order = "input";
-  int runs = 0;        ///< timed runs; the speed is their median
+  int runs = 0;        ///< timed runs (after one untimed warm-up); the speed is their median
   double seconds = 0;  ///< median time of one solve
   double collisions_per_second = 0;
   double bytes_per_collision = 0;     ///< traffic.hpp, in the row's precision
@@ -80,7 +81,7 @@ struct HardRow {
   std::size_t acting = 0;  ///< contacts with an impulse in the reference
   int threads = 1;
   std::string isa;  ///< the SIMD kernel's ISA
-  int runs = 0;     ///< timed runs; the speed is their median
+  int runs = 0;     ///< timed runs (after one untimed warm-up); the speed is their median
   double seconds = 0;
   double collisions_per_second = 0;
   double max_err_eps = 0;  ///< max |J - Jref| / (eps impulse_scale), the fast mode's unit (error_bound.hpp)
@@ -101,7 +102,7 @@ struct SweepPoint {
   std::string model;
   std::size_t n = 0;
   int threads = 1;
-  int runs = 0;
+  int runs = 0;  ///< timed runs (after one untimed warm-up); the rate is n over their median
   double collisions_per_second = 0;
   double bandwidth_fraction = 0;
 };
@@ -187,6 +188,23 @@ struct ReportOptions {
 /// (sort_report_rows). Progress goes to stderr only when it is a terminal.
 /// Throws std::invalid_argument for options out of range.
 Report measure_report(const ReportOptions& options);
+
+/// One kernel row's speed alone, timed as measure_report times it (the same
+/// functions): the SIMD path on default_isa(), fast mode, rigid model, float,
+/// without friction, at options.threads.front() threads, options.runs timed
+/// runs, on the generated `scene` ("pairs", "debris" or "pile") of options.n,
+/// debris_n or pile_n collisions and options.seed. No error sample (the error
+/// columns are 0) and no triad (bandwidth_fraction 0); note "speed only".
+/// For the check that compares the instruments (collide_bench
+/// --timing-check). Throws std::invalid_argument as measure_report does, and
+/// for another scene.
+ReportRow measure_kernel_speed(const ReportOptions& options, const std::string& scene);
+
+/// Only the N sweep's points of one model ("rigid" or "particle"), timed as
+/// measure_report times them: options.sweep_n on the largest thread count of
+/// options.threads, runs chosen as the sweep chooses them (options.quick
+/// included). No triad (bandwidth_fraction 0). Empty for an empty sweep_n.
+std::vector<SweepPoint> measure_sweep_report(const ReportOptions& options, const std::string& model);
 
 /// Only the hard section (the rows `collide report --hard` adds), for
 /// callers that want it alone (the Python module's report_hard()). Reads

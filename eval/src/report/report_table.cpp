@@ -89,7 +89,8 @@ std::string preamble(const Report& report) {
   }
   out += "peer: " + report.peer_status + "\n";
   std::snprintf(line, sizeof line,
-                "speed: median of timed runs of the solve alone; bw = share of the bandwidth bound.\n"
+                "speed: median of timed runs of the solve alone, after an untimed warm-up; bw = share of the bandwidth "
+                "bound.\n"
                 "error: vs reference_solve<long double> on the sample; err in eps x impulse scale (kernel bound "
                 "%.0f),\n"
                 "       rel = max |J-Jref|/|Jref|; dP, dL, dE = momentum, angular momentum, energy drift "

@@ -7,16 +7,21 @@
 //
 // Design notes
 // ------------
-// * Speed: each variant solves the full scene (--n collisions) `runs` times;
-//   before each run the velocities are restored from a saved copy, untimed,
-//   and only the solve call is timed (Solver::solve for the kernel, less
-//   its allocate phase: SolveStats::allocate_seconds). The
-//   median run is the row's speed, so one run disturbed by another process
-//   does not move it. The schedule is built once per
-//   scene, as a user solving every frame would do.
-// * The bandwidth bound: collisions/s x bytes_per_collision(model, sizeof(T),
-//   friction) (traffic.hpp) / triad bandwidth (bandwidth.hpp) measured at the
-//   same thread count at the start of the same run.
+// * Speed: every timed row, the N sweep's points and the hard rows follow
+//   the rule of collide/eval/timing.hpp (time_solve): one untimed warm-up
+//   solve, then `runs` timed solves of the full scene (--n collisions),
+//   each after an untimed restore of the velocities from a saved copy, the
+//   restore before the warm-up included; only the solve call is timed
+//   (Solver::solve for the kernel). The median run is the row's speed, so
+//   one run disturbed by another process does not move it. The schedule is
+//   built once per scene, as a user solving every frame would do.
+//   measure_kernel_speed() and measure_sweep_report() time one kernel row
+//   and the sweep by the same functions as the run, for the check that
+//   compares the instruments (collide_bench --timing-check).
+// * The bandwidth bound: bandwidth_fraction() (timing.hpp), collisions/s x
+//   bytes_per_collision(model, sizeof(T), friction) (traffic.hpp) / triad
+//   bandwidth (bandwidth.hpp) measured at the same thread count at the start
+//   of the same run.
 // * Error: each variant also solves an error sample (its own scene of
 //   --sample contacts; for the pairs scene that is exactly the first pairs of
 //   the full scene, since pair k depends only on (seed, k); for the pile, the
@@ -65,12 +70,12 @@
 #include <stdexcept>
 #include <string>
 #include <tuple>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "collide/eval/error_bound.hpp"
 #include "collide/eval/reference.hpp"
+#include "collide/eval/timing.hpp"
 #include "collide/eval/traffic.hpp"
 #include "collide/io/generate.hpp"
 #include "collide/io/scene.hpp"
@@ -149,24 +154,103 @@ class SavedVelocities {
   std::vector<T> saved_[6];
 };
 
-/// `runs` timed calls of solve(), each after an untimed restore(). A solve()
-/// that returns SolveStats is timed less its allocate phase (the solver's
-/// buffers grown on its first run: SolveStats::allocate_seconds).
-template <class Restore, class Solve>
-std::vector<double> time_runs(int runs, const Restore& restore, const Solve& solve) {
-  std::vector<double> seconds;
-  for (int r = 0; r < runs; ++r) {
-    restore();
-    const auto t0 = Clock::now();
-    if constexpr (std::is_same_v<decltype(solve()), SolveStats>) {
-      const SolveStats stats = solve();
-      seconds.push_back(std::max(0.0, seconds_since(t0) - stats.allocate_seconds));
-    } else {
-      solve();
-      seconds.push_back(seconds_since(t0));
-    }
+/// A row as measure_report starts it: what ran, on which scene; the
+/// figures follow.
+ReportRow new_row(SceneKind kind, const char* variant, Model model, const char* precision, bool friction, int threads,
+                  std::size_t n, std::size_t error_sample) {
+  ReportRow row;
+  row.scene = scene_name(kind);
+  row.variant = variant;
+  row.model = to_string(model);
+  row.precision = precision;
+  row.friction = friction;
+  row.threads = threads;
+  row.n = n;
+  row.error_sample = error_sample;
+  return row;
+}
+
+/// The speed columns of `row` from its timed runs: the median's rate and its
+/// fraction of the bandwidth bound at the row's thread count
+/// (`triad_bytes_per_second` 0: unknown, fraction 0).
+void finish_speed(ReportRow& row, const RunTimes& times, std::size_t value_bytes, Model model,
+                  double triad_bytes_per_second) {
+  row.runs = times.runs();
+  row.seconds = times.median;
+  row.collisions_per_second = row.seconds > 0 ? static_cast<double>(row.n) / row.seconds : 0;
+  row.bytes_per_collision = static_cast<double>(bytes_per_collision(model, value_bytes, row.friction));
+  row.bandwidth_fraction =
+      bandwidth_fraction(row.collisions_per_second, model, value_bytes, row.friction, triad_bytes_per_second);
+}
+
+/// A kernel row's timed runs: `s` solving the whole scene by the rule of
+/// collide/eval/timing.hpp (an untimed warm-up, the velocities restored
+/// untimed before every solve, `runs` timed solves). `stats` is the last
+/// solve's.
+template <class T>
+RunTimes time_kernel(const Solver& s, Model model, Scene<T>& scene, const SavedVelocities<T>& saved,
+                     const Schedule& schedule, ImpulseBuffer<T>& impulses, int runs, SolveStats& stats) {
+  const BodyView<T> bodies = scene.bodies.view();
+  const ContactView<T> contacts = scene.contacts.view();
+  return time_solve(
+      runs, [&] { saved.restore(bodies); },
+      [&] { stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
+}
+
+/// The sweep's timed runs at one N: about 0.2 s of them for small N, at
+/// least 5 and at most 200, and 3 for the scenes of millions of pairs, whose
+/// runs are long and steady; at most 5 with --quick.
+RunPlan sweep_plan(std::size_t n, bool quick) {
+  RunPlan plan = n >= 4000000 ? RunPlan::fixed(3) : RunPlan{5, 0.2, 200};
+  if (quick) plan.at_most = std::min(plan.at_most, 5);
+  return plan;
+}
+
+/// The N sweep of one model: `s` on the first N pairs of `scene` (float,
+/// frictionless, the model's bodies) for every N of `sizes`, each N timed
+/// by the rule of collide/eval/timing.hpp with sweep_plan(); `step` is told
+/// each point before it runs.
+void sweep_points(const Solver& s, Model model, Scene<float>& scene, const std::vector<std::size_t>& sizes, int threads,
+                  bool quick, double triad_bytes_per_second, std::vector<SweepPoint>& out,
+                  const std::function<void(const std::string&)>& step) {
+  ImpulseBuffer<float> impulses(scene.contacts.size());
+  SavedVelocities<float> saved;
+  Schedule schedule;
+  for (const std::size_t n : sizes) {
+    step("sweep: simd float " + std::string(to_string(model)) + ", " + std::to_string(n) + " pairs, " +
+         std::to_string(threads) + " thread(s)");
+    BodyView<float> bodies = scene.bodies.view();
+    bodies.count = 2 * n;
+    ContactView<float> contacts = scene.contacts.view();
+    contacts.count = n;
+    ImpulseView<float> j = impulses.view();
+    j.count = n;
+    schedule.build(contacts, bodies);
+    saved.save(bodies, bodies.count);
+    const RunTimes times = time_solve(
+        sweep_plan(n, quick), [&] { saved.restore(bodies); }, [&] { s.solve(model, bodies, contacts, j, schedule); });
+    saved.restore(bodies);  // the next N saves the first pairs as generated, not as solved
+    SweepPoint p;
+    p.model = to_string(model);
+    p.n = n;
+    p.threads = threads;
+    p.runs = times.runs();
+    p.collisions_per_second = times.median > 0 ? static_cast<double>(n) / times.median : 0;
+    p.bandwidth_fraction =
+        bandwidth_fraction(p.collisions_per_second, model, sizeof(float), false, triad_bytes_per_second);
+    out.push_back(p);
   }
-  return seconds;
+}
+
+/// The options of a kernel row's Solver.
+SolverOptions kernel_options(Path path, int threads, Isa isa, Accuracy accuracy, Order order = Order::input) {
+  SolverOptions options;
+  options.path = path;
+  options.threads = threads;
+  options.isa = isa;
+  options.accuracy = accuracy;
+  options.order = order;
+  return options;
 }
 
 // ---------------------------------------------------------------------------
@@ -232,15 +316,7 @@ class Runner {
     auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) +
                                (accuracy == Accuracy::accurate ? 16 : 0) + (order == Order::colour ? 32 : 0),
                            threads}];
-    if (!slot) {
-      SolverOptions options;
-      options.path = path;
-      options.threads = threads;
-      options.isa = isa;
-      options.accuracy = accuracy;
-      options.order = order;
-      slot = std::make_unique<Solver>(options);
-    }
+    if (!slot) slot = std::make_unique<Solver>(kernel_options(path, threads, isa, accuracy, order));
     return *slot;
   }
 
@@ -271,30 +347,6 @@ class Runner {
   }
 
   // -- rows ------------------------------------------------------------------
-
-  ReportRow new_row(SceneKind kind, const char* variant, Model model, const char* precision, bool friction, int threads,
-                    std::size_t n, std::size_t error_sample) {
-    ReportRow row;
-    row.scene = scene_name(kind);
-    row.variant = variant;
-    row.model = to_string(model);
-    row.precision = precision;
-    row.friction = friction;
-    row.threads = threads;
-    row.n = n;
-    row.error_sample = error_sample;
-    return row;
-  }
-
-  void finish_speed(ReportRow& row, std::vector<double> seconds, std::size_t value_bytes, Model model) {
-    row.runs = static_cast<int>(seconds.size());
-    row.seconds = median(std::move(seconds));
-    row.collisions_per_second = row.seconds > 0 ? static_cast<double>(row.n) / row.seconds : 0;
-    row.bytes_per_collision = static_cast<double>(bytes_per_collision(model, value_bytes, row.friction));
-    const auto it = triad_.find(row.threads);
-    const double bw = it != triad_.end() ? it->second : 0;
-    row.bandwidth_fraction = bw > 0 ? row.collisions_per_second * row.bytes_per_collision / bw : 0;
-  }
 
   [[nodiscard]] std::size_t sample_size() const { return report_sample_size(config_); }
 
@@ -386,6 +438,9 @@ class Runner {
         colour_order_rows(kind, friction, model, scene, sample, saved, colour_schedule, colour_sample_schedule,
                           impulses);
       }
+      // The velocities as generated, not as the last row's solve left them:
+      // the next model's scene is derived from them and saved.
+      saved.restore(scene.bodies.view());
     }
   }
 
@@ -417,16 +472,12 @@ class Runner {
   void measure_solver(ReportRow& row, const Solver& s, Model model, Scene<T>& scene, const Scene<T>& sample,
                       SavedVelocities<T>& saved, const Schedule& schedule, const Schedule& sample_schedule,
                       ImpulseBuffer<T>& impulses, const ReferenceResult& reference) {
-    const BodyView<T> bodies = scene.bodies.view();
-    const ContactView<T> contacts = scene.contacts.view();
     SolveStats stats;
-    std::vector<double> seconds = time_runs(
-        config_.runs, [&] { saved.restore(bodies); },
-        [&] { return stats = s.solve(model, bodies, contacts, impulses.view(), schedule); });
+    const RunTimes times = time_kernel(s, model, scene, saved, schedule, impulses, config_.runs, stats);
     row.lanes = stats.lanes;
     row.isa = to_string(stats.isa);
     row.layout = to_string(stats.layout);
-    finish_speed(row, std::move(seconds), sizeof(T), model);
+    finish_speed(row, times, sizeof(T), model, triad_bw(row.threads));
     BodyBuffer<T> after = sample.bodies;
     ImpulseBuffer<T> j(sample.contacts.size());
     s.solve(model, after.view(), sample.contacts.view(), j.view(), sample_schedule);
@@ -473,10 +524,10 @@ class Runner {
       ReportRow row =
           new_row(kind, "reference", Model::rigid, "long double", friction, 1, contacts.count, sample.contacts.size());
       progress_->show(row.scene + ": reference long double");
-      std::vector<double> seconds = time_runs(
+      const RunTimes times = time_solve(
           config_.runs, [&] { saved.restore(bodies.view()); },
           [&] { reference_solve<L>(bodies.view(), ld_contacts.view(), j.view()); });
-      finish_speed(row, std::move(seconds), sizeof(L), Model::rigid);
+      finish_speed(row, times, sizeof(L), Model::rigid, triad_bw(1));
       if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
 
       Scene<L> s = convert_scene<L>(sample);
@@ -494,10 +545,10 @@ class Runner {
       ReportRow row =
           new_row(kind, "reference", Model::rigid, "double", friction, 1, contacts.count, sample.contacts.size());
       progress_->show(row.scene + ": reference double");
-      std::vector<double> seconds = time_runs(
+      const RunTimes times = time_solve(
           config_.runs, [&] { saved.restore(bodies.view()); },
           [&] { reference_solve<double>(bodies.view(), contacts, j.view()); });
-      finish_speed(row, std::move(seconds), sizeof(double), Model::rigid);
+      finish_speed(row, times, sizeof(double), Model::rigid, triad_bw(1));
       if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
 
       BodyBuffer<double> after = sample.bodies;
@@ -519,10 +570,10 @@ class Runner {
     ReportRow row = new_row(kind, "textbook", Model::rigid, precision_name<T>(), friction, 1, contacts.count,
                             sample.contacts.size());
     progress_->show(row.scene + ": textbook " + row.precision);
-    std::vector<double> seconds = time_runs(
+    const RunTimes times = time_solve(
         config_.runs, [&] { saved.restore(bodies); }, [&] { textbook_solve<T>(bodies, contacts, j.view()); });
     saved.restore(bodies);  // the kernel rows start from the generated state
-    finish_speed(row, std::move(seconds), sizeof(T), Model::rigid);
+    finish_speed(row, times, sizeof(T), Model::rigid, triad_bw(1));
     if (contacts.count != scene.contacts.size()) row.note = "first " + std::to_string(contacts.count) + " contacts";
 
     BodyBuffer<T> after = sample.bodies;
@@ -541,42 +592,10 @@ class Runner {
     progress_->show("sweep: generating " + std::to_string(largest) + " pairs");
     Scene<float> scene = make_scene<float>(SceneKind::pairs, largest, false, config_.seed);
     const Solver& s = solver(Path::simd, threads, default_isa(), Accuracy::fast);
-    ImpulseBuffer<float> impulses(largest);
-    SavedVelocities<float> saved;
-    Schedule schedule;
     for (const Model model : {Model::rigid, Model::particle}) {
       if (model != Model::rigid) derive_model(scene, model);
-      for (const std::size_t n : config_.sweep_n) {
-        progress_->step("sweep: simd float " + std::string(to_string(model)) + ", " + std::to_string(n) + " pairs, " +
-                        std::to_string(threads) + " thread(s)");
-        BodyView<float> bodies = scene.bodies.view();
-        bodies.count = 2 * n;
-        ContactView<float> contacts = scene.contacts.view();
-        contacts.count = n;
-        ImpulseView<float> j = impulses.view();
-        j.count = n;
-        schedule.build(contacts, bodies);
-        saved.save(bodies, bodies.count);
-        auto restore = [&] { saved.restore(bodies); };
-        auto solve = [&] { return s.solve(model, bodies, contacts, j, schedule); };
-        // One untimed run warms the caches and tells how many runs fit: about
-        // 0.2 s of timed runs for small N, at least 5, and 3 for the scenes of
-        // millions of pairs, whose runs are long and steady.
-        const double estimate = median(time_runs(1, restore, solve));
-        int runs = n >= 4000000 ? 3 : std::clamp(static_cast<int>(0.2 / std::max(estimate, 1e-7)), 5, 200);
-        if (config_.quick) runs = std::min(runs, 5);
-        SweepPoint p;
-        p.model = to_string(model);
-        p.n = n;
-        p.threads = threads;
-        p.runs = runs;
-        const double seconds = median(time_runs(runs, restore, solve));
-        p.collisions_per_second = static_cast<double>(n) / seconds;
-        p.bandwidth_fraction = p.collisions_per_second *
-                               static_cast<double>(bytes_per_collision(model, sizeof(float), false)) /
-                               triad_bw(threads);
-        report_.sweep.push_back(p);
-      }
+      sweep_points(s, model, scene, config_.sweep_n, threads, config_.quick, triad_bw(threads), report_.sweep,
+                   [&](const std::string& what) { progress_->step(what); });
     }
   }
 
@@ -601,9 +620,11 @@ std::vector<HardRow> measure_hard_report(const ReportOptions& options) {
   return measure_hard_rows(options, [](const std::string&) {});
 }
 
-Report measure_report(const ReportOptions& options) {
-  // The same ranges as the usage of `collide report`: pairs use 2n body ids,
-  // which are 32-bit.
+namespace {
+
+/// Throws std::invalid_argument for options out of the ranges of the usage
+/// of `collide report`: pairs use 2n body ids, which are 32-bit.
+void require_valid(const ReportOptions& options) {
   auto require = [](bool ok, const char* what) {
     if (!ok) throw std::invalid_argument(std::string("report: ") + what);
   };
@@ -620,6 +641,62 @@ Report measure_report(const ReportOptions& options) {
   require(options.hard_n >= 1 && options.hard_n <= 0x7FFFFFFFULL, "hard_n must be from 1 to 2^31 - 1");
   require(options.scene_bodies.empty() == options.scene_contacts.empty(),
           "a scene of files needs both its bodies and its contacts file");
+}
+
+}  // namespace
+
+ReportRow measure_kernel_speed(const ReportOptions& options, const std::string& scene) {
+  require_valid(options);
+  SceneKind kind = SceneKind::pairs;
+  std::size_t n = options.n;
+  if (scene == "debris") {
+    kind = SceneKind::debris;
+    n = options.debris_n;
+  } else if (scene == "pile") {
+    kind = SceneKind::pile;
+    n = options.pile_n;
+  } else if (scene != "pairs") {
+    throw std::invalid_argument("report: the kernel speed's scene must be pairs, debris or pile, got '" + scene + "'");
+  }
+  Scene<float> s = make_scene<float>(kind, n, false, options.seed);
+  Schedule schedule;
+  schedule.build(s.contacts.view(), s.bodies.view());
+  ImpulseBuffer<float> impulses(s.contacts.size());
+  SavedVelocities<float> saved;
+  saved.save(s.bodies.view(), s.bodies.size());
+  const int threads = options.threads.front();
+  const Solver solver(kernel_options(Path::simd, threads, default_isa(), Accuracy::fast));
+  ReportRow row = new_row(kind, "simd", Model::rigid, "float", false, threads, s.contacts.size(), 0);
+  row.simd = true;
+  SolveStats stats;
+  const RunTimes times = time_kernel(solver, Model::rigid, s, saved, schedule, impulses, options.runs, stats);
+  row.lanes = stats.lanes;
+  row.isa = to_string(stats.isa);
+  row.layout = to_string(stats.layout);
+  finish_speed(row, times, sizeof(float), Model::rigid, 0);
+  row.note = "speed only";
+  return row;
+}
+
+std::vector<SweepPoint> measure_sweep_report(const ReportOptions& options, const std::string& model) {
+  require_valid(options);
+  if (model != "rigid" && model != "particle") {
+    throw std::invalid_argument("report: the sweep's model must be rigid or particle, got '" + model + "'");
+  }
+  std::vector<SweepPoint> points;
+  if (options.sweep_n.empty()) return points;
+  const int threads = *std::max_element(options.threads.begin(), options.threads.end());
+  const std::size_t largest = *std::max_element(options.sweep_n.begin(), options.sweep_n.end());
+  Scene<float> scene = make_scene<float>(SceneKind::pairs, largest, false, options.seed);
+  const Model m = model == "rigid" ? Model::rigid : Model::particle;
+  if (m != Model::rigid) derive_model(scene, m);
+  const Solver solver(kernel_options(Path::simd, threads, default_isa(), Accuracy::fast));
+  sweep_points(solver, m, scene, options.sweep_n, threads, options.quick, 0, points, [](const std::string&) {});
+  return points;
+}
+
+Report measure_report(const ReportOptions& options) {
+  require_valid(options);
   const auto t0 = Clock::now();
   Report report;
   report.n = options.n;
