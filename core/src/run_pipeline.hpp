@@ -4,7 +4,7 @@
 //
 // Design notes
 // ------------
-// * A run is applied contact after contact (kernel_isa.cpp, solve_run): each
+// * A run is applied contact after contact (kernel/loops.hpp, run_loop): each
 //   contact reads the velocities the one before left, one dependency chain
 //   that no lane and no thread can share. But most of a contact's
 //   arithmetic does not depend on velocities: its offsets, lever arms and K

@@ -164,8 +164,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const std::lock_guard<std::mutex> lock(prepare_mutex);
     detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
-    const detail::KernelJob<T> on_prepared = prepared_contacts.prepare(
-        *arena, job, stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
+    const detail::KernelJob<T> on_prepared =
+        prepared_contacts.prepare(*arena, job, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
     plan.prepared = true;
     detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());
