@@ -22,10 +22,10 @@
 
 # ---------------------------------------------------------------------------
 # Instruction sets. One library runs on every x86-64 and uses what the CPU
-# has: the SIMD kernel (core/src/kernel/loops.hpp, one unit per body model)
-# is compiled once per ISA, each copy in its own namespace, and a Solver
-# picks one at run time
-# (collide/isa.hpp; docs/embedding.md, "One binary, every x86-64"):
+# has: the SIMD kernel (core/src/kernel/loops.hpp, in units: kernel/units.hpp)
+# is compiled once per ISA, each copy in its own namespace, and a Solver picks
+# one at run time (collide/isa.hpp; docs/embedding.md, "One binary, every
+# x86-64"):
 #   sse2    4 float / 2 double lanes, the x86-64 baseline (also the scalar path)
 #   avx2    8 float / 4 double lanes
 #   avx512  16 float / 8 double lanes (AVX-512 F, BW, DQ, VL)

@@ -183,7 +183,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.model = job.model;
   stats.path = options.path;
   stats.friction = job.friction;
-  // The scalar path is the baseline object's one-lane kernel, on every ISA.
+  // The scalar path is the one-lane loops, compiled for the baseline, on every ISA.
   stats.isa = plan.simd ? table.isa : Isa::sse2;
   stats.isa_choice = pick.choice;
   stats.isa_calibration_seconds = pick.calibration_seconds;

@@ -22,8 +22,8 @@
 #   3. no fused multiply-add instruction in any object (the floating-point
 #      policy: AVX-512 includes FMA, and only -ffp-contract=off keeps the
 #      compiler from using it);
-#   4. the checks can fail: every AVX2 object of a model's loops does use
-#      ymm and every AVX-512 one zmm (otherwise the grep would prove nothing).
+#   4. the checks can fail: every AVX2 object of kernel loops does use ymm
+#      and every AVX-512 one zmm (otherwise the grep would prove nothing).
 #
 # Usage: test_isa_objects.sh NM OBJDUMP --avx2 OBJECT... --avx512 OBJECT... --baseline OBJECT...
 set -euo pipefail
@@ -105,8 +105,8 @@ for o in "${avx2[@]}" "${avx512[@]}" "${baseline[@]}"; do
   fi
 done
 
-# 4. The wide objects of the models' loops (all but the ISA's table,
-#    table.cpp's object) do use their registers.
+# 4. The wide objects of kernel loops (all but the ISA's table, table.cpp's
+#    object) do use their registers.
 used=0
 for isa in avx2 avx512; do
   if [ "$isa" = avx2 ]; then mine=("${avx2[@]}") reg=ymm; else mine=("${avx512[@]}") reg=zmm; fi
@@ -121,10 +121,10 @@ for isa in avx2 avx512; do
   done
 done
 if [ "$used" -lt 2 ]; then
-  echo "FAIL: no wide object of a model's loops was checked for its registers" >&2
+  echo "FAIL: no wide object of kernel loops was checked for its registers" >&2
   failed=1
 fi
-echo "wide: $used objects of the models' loops checked for their registers"
+echo "wide: $used objects of kernel loops checked for their registers"
 
 [ "$failed" -eq 0 ] && echo "test_isa_objects: passed"
 exit "$failed"

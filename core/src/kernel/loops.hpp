@@ -3,8 +3,8 @@
 // and scatter the results. Each loop is one named function for one choice of
 // body model, precision, accuracy mode, friction and body layout (or one of
 // the run's loops), and kernel_table.hpp's tables point at them. Included by
-// the units of one model each (kernel/particle.cpp, kernel/sphere.cpp,
-// kernel/rigid.cpp), compiled once per ISA with COLLIDE_KERNEL_NS naming it,
+// the kernel units, one per body model, precision and accuracy mode
+// (kernel/units.hpp), compiled once per ISA with COLLIDE_KERNEL_NS naming it,
 // and by the one-lane unit (kernel/scalar.cpp), compiled for the baseline
 // (core/CMakeLists.txt).
 //
@@ -628,6 +628,18 @@ void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const 
 // never inlined, reached only through the table's pointers.
 // ---------------------------------------------------------------------------
 
+/// A loop: never inlined, and everything it calls inlined into it (flatten),
+/// but for the calls kept out of line on purpose (noinline:
+/// load_streams_out_of_line, evaluate_law_accurately_out_of_line). So a
+/// loop's code depends on its own source alone. Left to GCC's heuristics,
+/// the inlining of what a loop calls beyond the forced inlining of lanes.hpp
+/// (libstdc++'s fixed-size simd operators, which the float accurate mode and
+/// the rigid float fast mode's double lanes use) depends on a budget for the
+/// whole unit (--param inline-unit-growth): in units of a few loops they
+/// were called out of line, hundreds of calls in a loop, where the one
+/// object of every loop had inlined them all.
+#define COLLIDE_KERNEL_LOOP __attribute__((noinline, flatten))
+
 /// The table's index of model M (Model's order: particle, sphere, rigid).
 template <class M>
 inline constexpr std::size_t kModelSlot = std::is_same_v<M, ParticleModel> ? static_cast<std::size_t>(Model::particle)
@@ -661,8 +673,8 @@ COLLIDE_LANE_INLINE const auto& bodies_of(const KernelJob<T>& job) {
 
 /// GroupLoops::solve: the law on groups of V::size() contacts.
 template <class M, class V, class Mode, bool kFriction, bool kPacked, class T = typename V::value_type>
-__attribute__((noinline)) std::size_t solve_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
-                                                 std::size_t end) {
+COLLIDE_KERNEL_LOOP std::size_t solve_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
+                                           std::size_t end) {
   assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked && job.friction == kFriction &&
          job.accurate == (std::is_same_v<Mode, AccurateMode>)&&!job.stepped);
   return solve_groups<M, V, kFriction, Mode, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.order,
@@ -673,8 +685,8 @@ __attribute__((noinline)) std::size_t solve_loop(const KernelJob<T>& job, bool c
 /// consecutive, whose geometry is formed (KernelJob::stepped), in groups of
 /// V::size().
 template <class M, class V, bool kPacked, class T = typename V::value_type>
-__attribute__((noinline)) std::size_t step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous,
-                                                std::size_t begin, std::size_t end) {
+COLLIDE_KERNEL_LOOP std::size_t step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous, std::size_t begin,
+                                          std::size_t end) {
   // Positions are contact indices: stepped jobs are prepared (identity order).
   assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
   assert(job.stepped && !job.accurate && !job.friction && (begin == end || job.order[begin] == begin));
@@ -691,7 +703,7 @@ __attribute__((noinline)) std::size_t step_loop(const KernelJob<T>& job, [[maybe
 /// KernelLoops::run: a run of the job in pieces (solve_run_pieces), its
 /// geometry in the lanes of this ISA.
 template <class M, class T, bool kPacked>
-__attribute__((noinline)) void run_loop(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
+COLLIDE_KERNEL_LOOP void run_loop(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
   assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
   assert(!job.accurate && !job.friction && !job.stepped);
   solve_run_pieces<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate,
@@ -700,8 +712,8 @@ __attribute__((noinline)) void run_loop(const KernelJob<T>& job, std::size_t beg
 
 /// KernelLoops::geometry (RunGeometryKernel of kernel_table.hpp).
 template <class M, class T, bool kPacked>
-__attribute__((noinline)) void geometry_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
-                                             const GeometryView<T>& into) {
+COLLIDE_KERNEL_LOOP void geometry_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                                       const GeometryView<T>& into) {
   assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
   assert(!job.accurate && !job.friction);
   piece_geometry<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.order + first, count, into);
@@ -709,45 +721,56 @@ __attribute__((noinline)) void geometry_loop(const KernelJob<T>& job, std::size_
 
 /// KernelLoops::walk (RunWalkKernel of kernel_table.hpp).
 template <class M, class T, bool kPacked>
-__attribute__((noinline)) void walk_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
-                                         const GeometryView<T>& geometry) {
+COLLIDE_KERNEL_LOOP void walk_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                                   const GeometryView<T>& geometry) {
   assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
   assert(!job.accurate && !job.friction);
   piece_walk<M, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate, job.order + first, count,
                    geometry);
 }
 
-/// Model M's slots of `loops` for one layout, in lanes V (an ISA's, or one lane).
-template <class M, class V, bool kPacked>
-void add_group_loops(GroupLoops<typename V::value_type>& loops) {
-  constexpr std::size_t m = kModelSlot<M>;
-  constexpr std::size_t l = kPacked ? 1 : 0;
-  loops.solve[m][0][0][l] = &solve_loop<M, V, FastMode, false, kPacked>;
-  loops.solve[m][0][1][l] = &solve_loop<M, V, FastMode, true, kPacked>;
-  loops.solve[m][1][0][l] = &solve_loop<M, V, AccurateMode, false, kPacked>;
-  loops.solve[m][1][1][l] = &solve_loop<M, V, AccurateMode, true, kPacked>;
-  loops.step[m][l] = &step_loop<M, V, kPacked>;
+/// Model M's solve slots of `loops` in mode Mode, in lanes V (an ISA's, or
+/// one lane): with and without friction, on both layouts.
+template <class M, class V, class Mode>
+void add_solve_loops(GroupLoops<typename V::value_type>& loops) {
+  auto& slots = loops.solve[kModelSlot<M>][std::is_same_v<Mode, AccurateMode> ? 1 : 0];
+  slots[0][0] = &solve_loop<M, V, Mode, false, false>;
+  slots[0][1] = &solve_loop<M, V, Mode, false, true>;
+  slots[1][0] = &solve_loop<M, V, Mode, true, false>;
+  slots[1][1] = &solve_loop<M, V, Mode, true, true>;
 }
 
-/// Model M's slots of `loops` in the lanes of this ISA, both layouts.
-template <class M, class T>
-void add_model_loops(KernelLoops<T>& loops) {
-  constexpr std::size_t m = kModelSlot<M>;
-  add_group_loops<M, SimdLanes<T>, false>(loops.groups);
-  add_group_loops<M, SimdLanes<T>, true>(loops.groups);
-  loops.run[m][0] = &run_loop<M, T, false>;
-  loops.run[m][1] = &run_loop<M, T, true>;
-  loops.geometry[m][0] = &geometry_loop<M, T, false>;
-  loops.geometry[m][1] = &geometry_loop<M, T, true>;
-  loops.walk[m][0] = &walk_loop<M, T, false>;
-  loops.walk[m][1] = &walk_loop<M, T, true>;
+/// Model M's velocity-step slots of `loops`, in lanes V, on both layouts.
+template <class M, class V>
+void add_step_loops(GroupLoops<typename V::value_type>& loops) {
+  loops.step[kModelSlot<M>][0] = &step_loop<M, V, false>;
+  loops.step[kModelSlot<M>][1] = &step_loop<M, V, true>;
 }
 
-/// Model M's one-lane slots of `loops`, both layouts.
+/// The slots of one kernel unit in the lanes of this ISA: model M's loops
+/// of precision T in mode Mode; the fast mode's unit also holds the loops
+/// that only the fast mode has (the velocity step and the run's).
+template <class M, class T, class Mode>
+void add_unit_loops(KernelLoops<T>& loops) {
+  add_solve_loops<M, SimdLanes<T>, Mode>(loops.groups);
+  if constexpr (std::is_same_v<Mode, FastMode>) {
+    constexpr std::size_t m = kModelSlot<M>;
+    add_step_loops<M, SimdLanes<T>>(loops.groups);
+    loops.run[m][0] = &run_loop<M, T, false>;
+    loops.run[m][1] = &run_loop<M, T, true>;
+    loops.geometry[m][0] = &geometry_loop<M, T, false>;
+    loops.geometry[m][1] = &geometry_loop<M, T, true>;
+    loops.walk[m][0] = &walk_loop<M, T, false>;
+    loops.walk[m][1] = &walk_loop<M, T, true>;
+  }
+}
+
+/// Model M's one-lane slots of `loops`: both modes, both layouts.
 template <class M, class T>
 void add_one_lane_loops(GroupLoops<T>& loops) {
-  add_group_loops<M, ScalarLanes<T>, false>(loops);
-  add_group_loops<M, ScalarLanes<T>, true>(loops);
+  add_solve_loops<M, ScalarLanes<T>, FastMode>(loops);
+  add_solve_loops<M, ScalarLanes<T>, AccurateMode>(loops);
+  add_step_loops<M, ScalarLanes<T>>(loops);
 }
 
 }  // namespace

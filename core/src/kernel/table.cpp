@@ -1,7 +1,7 @@
 // kernel/table.cpp - the table of one instruction set (kernel_table.hpp):
-// its lanes, and the loops of its three models' units. Compiled once per ISA
-// with the units (core/CMakeLists.txt).
-#include "kernel/models.hpp"
+// its lanes, and the loops of its kernel units (kernel/units.hpp). Compiled
+// once per ISA with the units (core/CMakeLists.txt).
+#include "kernel/units.hpp"
 #include "kernel_table.hpp"
 #include "lanes.hpp"
 
@@ -26,9 +26,18 @@ KernelTable make_table() {
   table.isa = this_isa();
   table.lanes_float = SimdLanes<float>::size();
   table.lanes_double = SimdLanes<double>::size();
-  add_particle_loops(table);
-  add_sphere_loops(table);
-  add_rigid_loops(table);
+  add_particle_float_fast(table);
+  add_particle_float_accurate(table);
+  add_particle_double_fast(table);
+  add_particle_double_accurate(table);
+  add_sphere_float_fast(table);
+  add_sphere_float_accurate(table);
+  add_sphere_double_fast(table);
+  add_sphere_double_accurate(table);
+  add_rigid_float_fast(table);
+  add_rigid_float_accurate(table);
+  add_rigid_double_fast(table);
+  add_rigid_double_accurate(table);
   return table;
 }
 
