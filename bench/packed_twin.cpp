@@ -53,7 +53,7 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
   const collide::ImpulseView<T>& j = impulses;
   Record* bodies = records.bodies;
   arena.execute([&] {
-    // As the kernel (kernel_isa.cpp, solve_groups): a contact's own lines
+    // As the kernel (kernel/loops.hpp, solve_groups): a contact's own lines
     // (its body indices, fields and J) are requested 2 kAhead contacts
     // ahead, its records kAhead ahead (reading the indices the first
     // request brought in, not missing on them).

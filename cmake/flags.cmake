@@ -8,6 +8,7 @@
 #   COLLIDE_ISA_FLAGS_<isa>  the flags of one kernel ISA (sse2, avx2, avx512),
 #                            for the per-ISA kernel objects (core/) and the
 #                            per-ISA tests of the lane layer (tests/)
+#   COLLIDE_KERNEL_ALIGN_FLAGS  the code alignment of every kernel object
 #
 # Everything outside the per-ISA kernels is compiled for the target's
 # baseline: no -march=native anywhere.
@@ -52,3 +53,18 @@ if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
   # 16-lane vectors into two ymm halves.
   set(COLLIDE_ISA_FLAGS_avx512 -mavx512f -mavx512bw -mavx512dq -mavx512vl -mprefer-vector-width=512)
 endif()
+
+# ---------------------------------------------------------------------------
+# Code placement of the kernel objects (core/CMakeLists.txt): every function
+# and every loop starts on a 64-byte boundary (a cache line, and a whole
+# number of the front end's fetch blocks). The speed of a kernel loop moved
+# with where it landed: a change to one loop moved the code after it, and
+# an unchanged loop's speed with it, by up to 1.39x
+# (docs/decisions/0036-the-avx512-gather-instruction-measured.md). Each loop
+# is its own function (core/src/kernel_table.hpp); aligned, a function's
+# start and its hot loops sit at the same offsets in their lines whatever
+# precedes them in the object, so placing or changing one variant does not
+# move another's speed. The padding costs a few kilobytes of code. Clang 14
+# accepts both flags too (the sanitizer build).
+# ---------------------------------------------------------------------------
+set(COLLIDE_KERNEL_ALIGN_FLAGS -falign-functions=64 -falign-loops=64)

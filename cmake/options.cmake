@@ -22,9 +22,10 @@
 
 # ---------------------------------------------------------------------------
 # Instruction sets. One library runs on every x86-64 and uses what the CPU
-# has: the SIMD kernel (core/src/kernel_isa.cpp) is compiled once per ISA,
-# each copy in its own namespace, and a Solver picks one at run time
-# (collide/isa.hpp; docs/embedding.md, "One binary, every x86-64"):
+# has: the SIMD kernel (core/src/kernel/loops.hpp, in units: kernel/units.hpp)
+# is compiled once per ISA, each copy in its own namespace, and a Solver picks
+# one at run time (collide/isa.hpp; docs/embedding.md, "One binary, every
+# x86-64"):
 #   sse2    4 float / 2 double lanes, the x86-64 baseline (also the scalar path)
 #   avx2    8 float / 4 double lanes
 #   avx512  16 float / 8 double lanes (AVX-512 F, BW, DQ, VL)
@@ -65,7 +66,7 @@ endif()
 
 # COLLIDE_PREFETCH_AHEAD: how many contacts ahead of the group it solves the
 # kernel requests the packed records of a batch (twice as far for a scattered
-# batch's own contact lines): kPrefetchAhead in core/src/kernel_isa.cpp, and
+# batch's own contact lines): kPrefetchAhead in core/src/kernel/loops.hpp, and
 # the same distance in the benchmark's packed twin (bench/packed_twin.cpp).
 # Far enough that the misses of a few groups overlap, near enough that the
 # lines are still in L1 when the group reads them (64 measured the same as 32:

@@ -13,10 +13,10 @@
 #     on, and the test passes; with it the first UB aborts the process, so a
 #     ctest run or a fuzzer fails on it.
 #   * -fno-omit-frame-pointer -g: readable stacks in the reports.
-#   * -O1: kernel_isa.cpp instantiates the kernel for 3 models x 2 paths x 2
-#     precisions x friction; at -O0 with instrumentation the tests run many
-#     times slower and at -O2/-O3 the build takes longer, for no extra
-#     findings. The level is applied after the build type's flags, so it wins.
+#   * -O1: the kernel units (core/src/kernel/) instantiate the kernel for
+#     3 models x 2 paths x 2 precisions x friction; at -O0 with
+#     instrumentation the tests run many times slower and at -O2/-O3 the
+#     build takes longer, for no extra findings. The level is applied after the build type's flags, so it wins.
 #     Configure sanitizer builds as Debug: NDEBUG stays undefined and the
 #     kernels' debug asserts (index range, a != b, view sizes) run too.
 #   * float-divide-by-zero is not part of "undefined" in GCC or Clang, and is

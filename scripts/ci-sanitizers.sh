@@ -17,7 +17,7 @@
 #      The sanitized builds compile one kernel, the baseline's
 #      (COLLIDE_KERNEL_ISAS=sse2: 4 float and 2 double lanes, and the
 #      one-lane kernel of every path): the kernel is one body over the lane
-#      type (kernel_isa.cpp), so a wider copy adds minutes of compile time
+#      type (core/src/kernel/loops.hpp), so a wider copy adds minutes of compile time
 #      and no code of its own, and the Release stage runs every ISA's. The
 #      libraries and the tool compile in unity batches (COLLIDE_UNITY_BUILD,
 #      as README command 1 builds them), so two sources of a batch that

@@ -431,7 +431,7 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
 // which reads the velocities the earlier contacts left. Every kernel
 // composes the two: the lanes form both at once (evaluate_law), a run of
 // contacts applied one after another forms the geometry in lanes and then
-// steps the contacts one by one (kernel_isa.cpp, piece_walk). No contact of a
+// steps the contacts one by one (kernel/loops.hpp, piece_walk). No contact of a
 // solve changes a position or an orientation, so the geometry may be formed
 // before the contacts ahead of it are stepped; either way the operations on
 // every value are the same.

@@ -10,7 +10,6 @@
 #include <limits>
 #include <mutex>
 #include <numeric>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -61,15 +60,6 @@ class Draw {
  private:
   std::uint64_t state_;
 };
-
-template <class T>
-RangeKernel<T> simd_kernel_of(const KernelTable& table) {
-  if constexpr (std::is_same_v<T, float>) {
-    return table.simd_float;
-  } else {
-    return table.simd_double;
-  }
-}
 
 /// The synthetic scene of one key, and the KernelJob that runs it.
 template <class T>
@@ -195,12 +185,13 @@ class CalibrationScene {
     std::copy(saved_rigid_.bodies.begin(), saved_rigid_.bodies.end(), rigid_records_.bodies.begin());
   }
 
-  /// One pass of `kernel` over the first `contacts` of the order; returns
-  /// its wall time [s].
-  double pass(RangeKernel<T> kernel, std::size_t contacts) {
+  /// One pass of the SIMD loops of `table` over the first `contacts` of the
+  /// order; returns its wall time [s].
+  double pass(const KernelTable& table, std::size_t contacts) {
+    const JobKernels<T> kernels = job_kernels(table, job_, true);
     restore();
     const auto t0 = Clock::now();
-    kernel(job_, !scattered_, 0, contacts);
+    kernels.range(job_, !scattered_, 0, contacts);
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
@@ -231,7 +222,7 @@ IsaMeasurement measure(Model model, Accuracy accuracy, bool scattered) {
   // Warm-up: code and data into the caches, and the slowest cost per contact.
   double slowest = 0;
   for (const Isa isa : isas) {
-    const double seconds = scene.pass(simd_kernel_of<T>(kernel_table(isa)), kWarmUpContacts);
+    const double seconds = scene.pass(kernel_table(isa), kWarmUpContacts);
     slowest = std::max(slowest, seconds / static_cast<double>(kWarmUpContacts));
   }
   std::size_t contacts = kContacts;
@@ -244,7 +235,7 @@ IsaMeasurement measure(Model model, Accuracy accuracy, bool scattered) {
   for (int round = 0; round < kRounds; ++round) {
     for (std::size_t i = 0; i < isas.size(); ++i) {
       const Isa isa = isas[(i + static_cast<std::size_t>(round)) % isas.size()];
-      const double seconds = scene.pass(simd_kernel_of<T>(kernel_table(isa)), contacts);
+      const double seconds = scene.pass(kernel_table(isa), contacts);
       best[isa_index(isa)] = std::min(best[isa_index(isa)], seconds);
     }
   }

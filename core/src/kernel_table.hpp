@@ -1,22 +1,40 @@
 // kernel_table.hpp - the seam between the driver (solve.cpp, compiled for the
-// baseline) and the kernel compiled once per instruction set (kernel_isa.cpp).
+// baseline) and the kernel's loops, compiled once per instruction set and
+// body model (kernel/loops.hpp).
 //
 // Design notes
 // ------------
 // The driver owns everything that is not arithmetic on lanes: the schedule
 // walk, TBB, the stats. It hands a kernel a KernelJob and a range of the
-// schedule's order, through a function pointer looked up once, when the
-// Solver is built (kernel_table(Isa)). The per-ISA objects contain nothing but
-// the kernel templates, in an inline namespace named for their ISA
-// (lanes.hpp), and these entry points with ISA-suffixed names: no TBB, no
-// standard-library code that is not inlined (tests/core/test_isa_objects.sh
-// checks the objects), so the linker can never pick a wide-ISA copy of a
-// function for a narrow path. One indirect call per block of ~1024 contacts is
-// the whole cost of dispatch.
+// schedule's order. Each loop of the kernel is one named function for one
+// choice of body model, precision, accuracy mode, friction and body layout,
+// and a table per ISA holds a pointer to each, in arrays indexed by those
+// choices (KernelLoops). The choice is made once per solve, by one lookup
+// (job_kernels), not by branches inside the loops; an indirect call per
+// block of ~1024 contacts (and one for its tail) is then the whole cost of
+// dispatch.
+//
+// Why one function per choice, and several objects per ISA: when one object
+// held every loop of an ISA, all inlined into a few entry points, it took
+// 140-250 s to compile, and a change to one loop moved the others' code and
+// with it their speed, by up to 1.39x on an unchanged loop
+// (docs/decisions/0036-the-avx512-gather-instruction-measured.md). Now the
+// loops of one model, precision and accuracy mode are an object of their own
+// (kernel/units.hpp: kernel/rigid_float_fast.cpp, ...), each compiled in
+// under a minute, and every function and loop of a kernel object starts on a
+// 64-byte boundary (cmake/flags.cmake), so a loop's placement does not depend
+// on what precedes it.
+//
+// The per-ISA objects contain nothing but the kernel templates, in an inline
+// namespace named for their ISA (lanes.hpp) and an anonymous one, and their
+// entry points with ISA-suffixed names: no TBB, no standard-library code
+// that is not inlined (tests/core/test_isa_objects.sh checks the objects), so
+// the linker can never pick a wide-ISA copy of a function for a narrow path.
 //
 // The scalar path, and the last (count mod W) contacts of every SIMD range,
-// run the baseline object's one-lane kernel: the same operations in the same
-// order, so each lane and the tail agree bit for bit whatever the ISA.
+// run the one-lane loops (OneLaneTable, kernel/scalar.cpp, compiled for the
+// baseline): the same operations in the same order, so each lane and the
+// tail agree bit for bit whatever the ISA.
 #pragma once
 
 #include <cstddef>
@@ -94,16 +112,18 @@ struct KernelJob {
 };
 
 /// Resolves order[begin, end) (all inside one batch; `contiguous` when the
-/// batch's order is consecutive indices).
+/// batch's order is consecutive indices) in groups of the loop's lanes;
+/// returns where the groups stopped: the tail, fewer contacts than the
+/// lanes, is the one-lane loop's (a one-lane loop returns `end`).
 template <class T>
-using RangeKernel = void (*)(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
+using GroupLoop = std::size_t (*)(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
 
 /// Resolves order[begin, end) one contact after another: a run of batches
 /// too small to fill the lanes (a chain), whose contacts may share bodies.
 template <class T>
 using RunKernel = void (*)(const KernelJob<T>& job, std::size_t begin, std::size_t end);
 
-/// Contacts per piece of a run (solve_run in kernel_isa.cpp): the geometry
+/// Contacts per piece of a run (solve_run_pieces in kernel/loops.hpp): the geometry
 /// of a piece, 64 bytes a contact in float, stays in L1 between the pass that
 /// forms it and the walk that reads it.
 inline constexpr std::size_t kRunPiece = 128;
@@ -148,22 +168,49 @@ template <class T>
 using RunWalkKernel = void (*)(const KernelJob<T>& job, std::size_t first, std::size_t count,
                                const GeometryView<T>& geometry);
 
-/// The SIMD kernels of one instruction set.
+// The choices that name a loop, the extents of the tables' arrays.
+inline constexpr std::size_t kModels = 3;     ///< Model: particle, sphere, rigid
+inline constexpr std::size_t kModes = 2;      ///< fast, accurate (KernelJob::accurate)
+inline constexpr std::size_t kFrictions = 2;  ///< without, with (KernelJob::friction)
+inline constexpr std::size_t kLayouts = 2;    ///< SoA views, packed records (KernelJob::packed)
+
+/// The loops over groups of one lane width (an ISA's, or one lane), one per
+/// choice of model, mode, friction and layout.
+template <class T>
+struct GroupLoops {
+  /// The law: solve[model][accurate][friction][packed].
+  GroupLoop<T> solve[kModels][kModes][kFrictions][kLayouts] = {};
+  /// The velocity step on the stored geometry (KernelJob::stepped: fast
+  /// mode, frictionless): step[model][packed].
+  GroupLoop<T> step[kModels][kLayouts] = {};
+};
+
+/// The loops of one instruction set and precision: the group loops in its
+/// lanes, and the loops of a run (fast mode, frictionless), by [model][packed].
+template <class T>
+struct KernelLoops {
+  GroupLoops<T> groups;
+  RunKernel<T> run[kModels][kLayouts] = {};  ///< a run in pieces, each its geometry then its walk
+  RunGeometryKernel<T> geometry[kModels][kLayouts] = {};
+  RunWalkKernel<T> walk[kModels][kLayouts] = {};
+};
+
+/// The loops of one instruction set.
 struct KernelTable {
   Isa isa = Isa::sse2;
   std::size_t lanes_float = 0;
   std::size_t lanes_double = 0;
-  RangeKernel<float> simd_float = nullptr;
-  RangeKernel<double> simd_double = nullptr;
-  RunKernel<float> run_float = nullptr;
-  RunKernel<double> run_double = nullptr;
-  RunGeometryKernel<float> run_geometry_float = nullptr;
-  RunGeometryKernel<double> run_geometry_double = nullptr;
-  RunWalkKernel<float> run_walk_float = nullptr;
-  RunWalkKernel<double> run_walk_double = nullptr;
+  KernelLoops<float> loops_float;
+  KernelLoops<double> loops_double;
 };
 
-/// The entry of a KernelTable for precision T: its float one or its double one.
+/// The one-lane loops: the scalar path and the tail of every SIMD range.
+struct OneLaneTable {
+  GroupLoops<float> loops_float;
+  GroupLoops<double> loops_double;
+};
+
+/// The entry of a table for precision T: its float one or its double one.
 template <class T, class F, class D>
 auto of_precision(const F& for_float, const D& for_double) {
   if constexpr (std::is_same_v<T, float>) {
@@ -176,15 +223,64 @@ auto of_precision(const F& for_float, const D& for_double) {
 /// The table of a concrete ISA (not automatic) that this build has.
 const KernelTable& kernel_table(Isa isa);
 
-/// The one-lane kernel (the scalar path and every SIMD tail), from the
-/// baseline object.
-template <class T>
-void solve_range_scalar(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end);
+/// The one-lane loops, compiled for the baseline (kernel/scalar.cpp).
+const OneLaneTable& one_lane_table();
 
-// One per kernel object (kernel_isa.cpp defines the one of its ISA).
-const KernelTable& kernel_table_sse2();
-const KernelTable& kernel_table_avx2();
-const KernelTable& kernel_table_avx512();
-const KernelTable& kernel_table_native();
+/// The same tables, writable: only tests write them, to count the calls of
+/// every entry (tests/core/test_dispatch.cpp). Nothing in the library does.
+KernelTable& writable_kernel_table(Isa isa);
+OneLaneTable& writable_one_lane_table();
+
+/// The loops that run one job, looked up once per solve in the tables at
+/// the job's model, mode, friction and layout (job_kernels).
+template <class T>
+struct JobKernels {
+  /// The law, or the velocity step (KernelJob::stepped), in the lanes of
+  /// the table's ISA; on the scalar path, the one-lane loop.
+  GroupLoop<T> groups = nullptr;
+  /// The same in one lane: the tail of a SIMD range, the scalar path, and a
+  /// run in the accurate mode or with friction.
+  GroupLoop<T> one_lane = nullptr;
+  /// A run in pieces (fast mode, frictionless, not stepped); otherwise null.
+  RunKernel<T> run_pieces = nullptr;
+  /// The two halves of a run (fast mode, frictionless); otherwise null.
+  RunGeometryKernel<T> geometry = nullptr;
+  RunWalkKernel<T> walk = nullptr;
+
+  /// Resolves order[begin, end) of one batch: whole groups in the lanes,
+  /// the tail in one lane.
+  void range(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) const {
+    const std::size_t tail = groups(job, contiguous, begin, end);
+    if (tail < end) one_lane(job, contiguous, tail, end);
+  }
+
+  /// Resolves the run order[begin, end) on this thread (RunKernel): in
+  /// pieces; or, when its geometry is formed (KernelJob::stepped), its walk
+  /// alone; the accurate mode and friction take the one-lane loop, contact by
+  /// contact.
+  void run(const KernelJob<T>& job, std::size_t begin, std::size_t end) const {
+    if (job.stepped) {
+      walk(job, begin, end - begin, job.geometry.from(begin));
+    } else if (run_pieces != nullptr) {
+      run_pieces(job, begin, end);
+    } else {
+      one_lane(job, false, begin, end);
+    }
+  }
+};
+
+/// The loops of `job` in `table` (with `simd` false, the scalar path: the
+/// one-lane loops for its groups).
+template <class T>
+JobKernels<T> job_kernels(const KernelTable& table, const KernelJob<T>& job, bool simd);
+
+extern template JobKernels<float> job_kernels<float>(const KernelTable&, const KernelJob<float>&, bool);
+extern template JobKernels<double> job_kernels<double>(const KernelTable&, const KernelJob<double>&, bool);
+
+// One per instruction set (kernel/table.cpp defines the one of its ISA).
+KernelTable& kernel_table_sse2();
+KernelTable& kernel_table_avx2();
+KernelTable& kernel_table_avx512();
+KernelTable& kernel_table_native();
 
 }  // namespace collide::detail

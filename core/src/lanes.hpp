@@ -36,8 +36,9 @@
 #endif
 
 // The inline namespace every kernel template lives in: the ISA the including
-// file is compiled for (kernel_isa.cpp is compiled once per ISA with
-// COLLIDE_KERNEL_NS=sse2, avx2, avx512; see CMakeLists.txt). Templates of one
+// file is compiled for (the kernel units of kernel/loops.hpp are compiled
+// once per ISA with COLLIDE_KERNEL_NS=sse2, avx2, avx512; see
+// core/CMakeLists.txt). Templates of one
 // ISA thus never share a mangled name with those of another, and the linker
 // cannot hand a narrower path a copy compiled for a wider ISA. Code that is not
 // a per-ISA kernel (tests, benchmarks) gets `host`, its own target's lanes.
@@ -47,10 +48,12 @@
 
 // Everything a kernel body calls is forced inline: GCC's heuristics give up
 // on functions that take several 8-lane structs, and an out-of-line call
-// passes them through memory: gather_bodies (kernel_isa.cpp) out of line
-// costs a third of the kernel's time. The one exception is measured:
-// load_streams_out_of_line (kernel_isa.cpp), where three kinds of loads met
-// inside the law and made it spill.
+// passes them through memory: gather_bodies (kernel/loops.hpp) out of line
+// costs a third of the kernel's time. The exceptions are measured:
+// load_streams_out_of_line (kernel/loops.hpp), where three kinds of loads
+// met inside the law and made it spill, and the double accurate law
+// (contact_kernel.hpp). The loops themselves are functions of their own,
+// one per choice of the kernel table (kernel_table.hpp), never inlined.
 #define COLLIDE_LANE_INLINE inline __attribute__((always_inline))
 // The same for the lambdas a kernel passes to its field visitors.
 #define COLLIDE_LANE_LAMBDA __attribute__((always_inline))

@@ -4,12 +4,12 @@
 //
 // Design notes
 // ------------
-// * A run is applied contact after contact (kernel_isa.cpp, solve_run): each
+// * A run is applied contact after contact (kernel/loops.hpp, run_loop): each
 //   contact reads the velocities the one before left, one dependency chain
 //   that no lane and no thread can share. But most of a contact's
 //   arithmetic does not depend on velocities: its offsets, lever arms and K
 //   terms (the whole of the rigid float kernel's double-lane work), which
-//   solve_run forms piece by piece in lanes before walking the piece. Here a
+//   run_loop forms piece by piece in lanes before walking the piece. Here a
 //   helper thread forms them for the pieces ahead, so the walking thread
 //   does the walk alone.
 // * The pieces sit in kSlots slots, each stamped with the number of the
@@ -23,7 +23,7 @@
 //   walk, run_schedule.cpp), help. A helper waits for the walk only while
 //   the walk runs on another thread, nothing can deadlock, and the walk ends
 //   whether a helper comes at once, late or never.
-// * The same geometry and the same walk as solve_run, in the same order for
+// * The same geometry and the same walk as run_loop, in the same order for
 //   every contact: the same bits on one thread or two.
 // * SoA layouts only: the geometry reads positions, orientations and inverse
 //   masses, never the velocities the walk writes (a packed record holds
@@ -74,7 +74,7 @@ class SpinWait {
   int spins_ = 0;
 };
 
-/// A run of contacts order[begin, end) resolved as solve_run does, its
+/// A run of contacts order[begin, end) resolved as run_loop does, its
 /// pieces' geometry formed by whichever threads call help() while one thread
 /// calls walk(). Preconditions: fast mode, no friction, a SoA body layout.
 template <class T>

@@ -44,10 +44,7 @@ class Walk {
       : plan_(plan),
         threads_(threads),
         schedule_(schedule),
-        kernel_(plan.simd ? of_precision<T>(table.simd_float, table.simd_double) : &solve_range_scalar<T>),
-        run_kernel_(of_precision<T>(table.run_float, table.run_double)),
-        run_geometry_(of_precision<T>(table.run_geometry_float, table.run_geometry_double)),
-        run_walk_(of_precision<T>(table.run_walk_float, table.run_walk_double)),
+        kernels_(job_kernels(table, job, plan.simd)),
         first_(job),
         later_(job) {
     later_.accumulate = true;
@@ -134,7 +131,7 @@ class Walk {
     const std::size_t w = plan_.width;
     const std::size_t per_item = ((end - begin + s.items - 1) / s.items + w - 1) / w * w;
     const std::size_t b = begin + item * per_item;
-    if (b < end) kernel_(job, consecutive(k), b, std::min(end, b + per_item));
+    if (b < end) kernels_.range(job, consecutive(k), b, std::min(end, b + per_item));
   }
 
   /// Batch k's contacts are consecutive in the job's arrays.
@@ -146,7 +143,7 @@ class Walk {
   /// Batches [k, end) in order on this thread. Stretches of batches that
   /// run alone are one run, resolved contact after contact in the
   /// schedule's order (the law's order; the run kernel keeps the one-lane
-  /// kernel's bits, kernel_isa.cpp, solve_run).
+  /// loop's bits, JobKernels::run in kernel_table.hpp).
   void run_serial(const KernelJob<T>& job, std::size_t k, std::size_t end) {
     while (k < end) {
       const std::size_t begin = schedule_.batch_begin(k);
@@ -156,14 +153,14 @@ class Walk {
       }
       const std::size_t stop = schedule_.batch_begin(last);
       if (last == k + 1) {
-        kernel_(job, consecutive(k), begin, stop);
+        kernels_.range(job, consecutive(k), begin, stop);
       } else if (!plan_.simd) {
-        solve_range_scalar<T>(job, false, begin, stop);
+        kernels_.one_lane(job, false, begin, stop);
       } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction && !job.stepped &&
                  stop - begin >= kPipelinedRunPieces * kRunPiece) {
         run_pipelined(job, begin, stop);
       } else {
-        run_kernel_(job, begin, stop);
+        kernels_.run(job, begin, stop);
       }
       k = last;
     }
@@ -171,7 +168,7 @@ class Walk {
 
   /// A long run, its pieces' geometry formed by the threads waiting for it.
   void run_pipelined(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
-    PipelinedRun<T> run(run_geometry_, run_walk_, job, begin, end);
+    PipelinedRun<T> run(kernels_.geometry, kernels_.walk, job, begin, end);
     run_.store(&run, std::memory_order_seq_cst);
     run.walk();
     run_.store(nullptr, std::memory_order_seq_cst);
@@ -195,12 +192,9 @@ class Walk {
   const WalkPlan& plan_;
   const int threads_;
   const Schedule& schedule_;
-  const RangeKernel<T> kernel_;
-  const RunKernel<T> run_kernel_;
-  const RunGeometryKernel<T> run_geometry_;
-  const RunWalkKernel<T> run_walk_;
-  KernelJob<T> first_;  // the first pass: J written
-  KernelJob<T> later_;  // the passes after: J added
+  const JobKernels<T> kernels_;  // the job's loops, looked up once (first_ and later_ differ only in accumulate)
+  KernelJob<T> first_;           // the first pass: J written
+  KernelJob<T> later_;           // the passes after: J added
   std::array<std::atomic<std::uint64_t>, kMaxItems> stamps_{};
   std::atomic<std::uint64_t> finished_{0};
   std::atomic<PipelinedRun<T>*> run_{nullptr};

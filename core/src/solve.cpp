@@ -183,8 +183,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
     const auto t_allocate = Clock::now();
     if (prepared_contacts.allocate(*arena, job, stepped)) allocate_seconds += seconds_since(t_allocate);
-    const detail::KernelJob<T> on_prepared = prepared_contacts.prepare(
-        *arena, job, stepped ? detail::of_precision<T>(table.run_geometry_float, table.run_geometry_double) : nullptr);
+    const detail::KernelJob<T> on_prepared =
+        prepared_contacts.prepare(*arena, job, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
     plan.prepared = true;
     detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());
@@ -202,7 +202,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.model = job.model;
   stats.path = options.path;
   stats.friction = job.friction;
-  // The scalar path is the baseline object's one-lane kernel, on every ISA.
+  // The scalar path is the one-lane loops, compiled for the baseline, on every ISA.
   stats.isa = plan.simd ? table.isa : Isa::sse2;
   stats.isa_choice = pick.choice;
   stats.isa_calibration_seconds = pick.calibration_seconds;

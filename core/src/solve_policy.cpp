@@ -71,7 +71,7 @@ std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, con
   // A colour of a window holds every few contacts of a stretch of the input:
   // not consecutive, but in a pile or a chain in a broadphase's order their
   // bodies follow one another (the kernel then loads them as vectors,
-  // kernel_isa.cpp), so the colour order samples those batches too.
+  // kernel/loops.hpp), so the colour order samples those batches too.
   const bool sample_gathered = schedule.ordering() == Order::colour;
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
     const std::size_t begin = schedule.batch_begin(k);

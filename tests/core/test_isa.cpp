@@ -216,7 +216,7 @@ void shared_and_hard_scenes() {
 }
 
 /// Chains: runs of one-contact batches, which the SIMD path applies contact
-/// after contact with lever arms formed in lanes (kernel_isa.cpp, solve_run).
+/// after contact with lever arms formed in lanes (kernel/loops.hpp, run_loop).
 /// 1037 contacts: pieces of 128 and groups of every width end mid-way. Every
 /// 301st box is immovable (the run must neither move nor write it), in
 /// both layouts, both modes, with and without friction (which, like the

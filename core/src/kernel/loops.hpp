@@ -1,37 +1,52 @@
-// kernel_isa.cpp - the kernel for one instruction set: gathers contacts and
-// bodies into lanes, runs the kernel body of contact_kernel.hpp, scatters the
-// results. Compiled once per ISA (core/CMakeLists.txt) with
-// COLLIDE_KERNEL_NS naming it; kernel_table.hpp is the seam to the driver.
+// kernel/loops.hpp - the kernel's loops for one lane width: they gather
+// contacts and bodies into lanes, run the kernel body of contact_kernel.hpp
+// and scatter the results. Each loop is one named function for one choice of
+// body model, precision, accuracy mode, friction and body layout (or one of
+// the run's loops), and kernel_table.hpp's tables point at them. Included by
+// the kernel units, one per body model, precision and accuracy mode
+// (kernel/units.hpp), compiled once per ISA with COLLIDE_KERNEL_NS naming it,
+// and by the one-lane unit (kernel/scalar.cpp), compiled for the baseline
+// (core/CMakeLists.txt).
 //
 // Design notes
 // ------------
 // * A range is processed W contacts at a time; the last (count mod W)
-//   contacts run through the baseline object's one-lane kernel
-//   (solve_range_scalar). Same operations, same order, no FMA: the tail is
-//   bitwise what a lane would have produced, on every ISA.
+//   contacts run through the one-lane loop of the same choices (the
+//   baseline's, kernel/scalar.cpp). Same operations, same order, no FMA: the
+//   tail is bitwise what a lane would have produced, on every ISA.
 // * Contiguous batches (every scene without shared movable bodies, like the
 //   pairs scene) load contact fields as vectors; only the first index of
 //   each group is read from `order`.
 // * Immovable bodies are gathered but never written: many lanes may read the
 //   one ground body at once, none writes it.
+// * Everything here is in an anonymous namespace: a unit's loops have
+//   internal linkage, so no object defines a weak (vague-linkage) function
+//   that another could take (tests/core/test_isa_objects.sh), and a unit
+//   holds only the loops its model's slots point at. The loops themselves
+//   are never inlined (they are reached only through the table); what they
+//   call is forced inline (lanes.hpp), as it was when one object held every
+//   loop.
 // * Nothing here allocates, spawns or locks: threads are the driver's
 //   (solve.cpp); this file is arithmetic and memory only.
+#pragma once
+
+#ifndef COLLIDE_KERNEL_NS
+#error "kernel/loops.hpp is compiled once per ISA with COLLIDE_KERNEL_NS set (core/CMakeLists.txt)"
+#endif
+
 #include <algorithm>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
+#include "collide/model.hpp"
 #include "contact_kernel.hpp"
 #include "kernel_table.hpp"
 #include "record_lanes.hpp"
 
 #ifndef COLLIDE_PREFETCH_AHEAD
 #define COLLIDE_PREFETCH_AHEAD 32
-#endif
-
-#ifndef COLLIDE_KERNEL_NS
-#error "kernel_isa.cpp is compiled once per ISA with COLLIDE_KERNEL_NS set (core/CMakeLists.txt)"
 #endif
 
 namespace collide::detail {
@@ -468,69 +483,6 @@ COLLIDE_LANE_INLINE std::size_t solve_groups(const View& bodies, const ContactVi
   return i;
 }
 
-/// Calls f(view, model) with the job's body view and model.
-template <class T, class F>
-decltype(auto) with_view(const KernelJob<T>& job, const F& f) {
-  if (job.packed) {
-    switch (job.model) {
-      case Model::particle:
-        return f(job.packed_particle, ParticleModel{});
-      case Model::sphere:
-        return f(job.packed_sphere, SphereModel{});
-      case Model::rigid:
-        break;
-    }
-    return f(job.packed_rigid, RigidModel{});
-  }
-  switch (job.model) {
-    case Model::particle:
-      return f(job.particle, ParticleModel{});
-    case Model::sphere:
-      return f(job.sphere, SphereModel{});
-    case Model::rigid:
-      break;
-  }
-  return f(job.rigid, RigidModel{});
-}
-
-/// The job's model and friction, as template arguments.
-template <class V, class T, class Mode>
-std::size_t solve_job_groups_in(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
-  // `view` is a SoA view or a PackedView: solve_group tells them apart.
-  return with_view(job, [&](const auto& view, auto model) {
-    using M = decltype(model);
-    return job.friction ? solve_groups<M, V, true, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous,
-                                                            job.accumulate, begin, end)
-                        : solve_groups<M, V, false, Mode, T>(view, job.contacts, job.impulses, job.order, contiguous,
-                                                             job.accumulate, begin, end);
-  });
-}
-
-/// The velocity step of the job's contacts [begin, end), consecutive, whose
-/// geometry is formed (KernelJob::stepped), in groups of W.
-template <class V, class T>
-std::size_t step_job_groups(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
-  // Positions are contact indices: stepped jobs are prepared (identity order).
-  assert(job.stepped && !job.accurate && !job.friction && (begin == end || job.order[begin] == begin));
-  constexpr std::size_t W = V::size();
-  return with_view(job, [&](const auto& view, auto model) {
-    std::size_t i = begin;
-    for (; i + W <= end; i += W) {
-      step_group<decltype(model), V, T>(view, job.contacts, job.impulses, job.geometry, static_cast<std::uint32_t>(i),
-                                        job.accumulate);
-    }
-    return i;
-  });
-}
-
-/// ... and its accuracy mode (or only the velocity step).
-template <class V, class T>
-std::size_t solve_job_groups(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
-  if (job.stepped) return step_job_groups<V, T>(job, begin, end);
-  return job.accurate ? solve_job_groups_in<V, T, AccurateMode>(job, contiguous, begin, end)
-                      : solve_job_groups_in<V, T, FastMode>(job, contiguous, begin, end);
-}
-
 template <class V>
 COLLIDE_LANE_INLINE void store3(const Vec3<V>& v, typename V::value_type* const (&to)[3], std::size_t at) {
   store(v.x, to[0] + at);
@@ -671,95 +623,156 @@ void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const 
   }
 }
 
-/// RunGeometryKernel and RunWalkKernel of kernel_table.hpp.
-template <class T>
-void run_piece_geometry(const KernelJob<T>& job, std::size_t first, std::size_t count, const GeometryView<T>& into) {
-  assert(!job.accurate && !job.friction);
-  with_view(job, [&](const auto& view, auto model) {
-    piece_geometry<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.order + first, count, into);
-  });
-}
-template <class T>
-void run_piece_walk(const KernelJob<T>& job, std::size_t first, std::size_t count, const GeometryView<T>& geometry) {
-  assert(!job.accurate && !job.friction);
-  with_view(job, [&](const auto& view, auto model) {
-    piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + first, count,
-                                   geometry);
-  });
+// ---------------------------------------------------------------------------
+// The loops: one named function per choice of the table (kernel_table.hpp),
+// never inlined, reached only through the table's pointers.
+// ---------------------------------------------------------------------------
+
+/// A loop: never inlined, and everything it calls inlined into it (flatten),
+/// but for the calls kept out of line on purpose (noinline:
+/// load_streams_out_of_line, evaluate_law_accurately_out_of_line). So a
+/// loop's code depends on its own source alone. Left to GCC's heuristics,
+/// the inlining of what a loop calls beyond the forced inlining of lanes.hpp
+/// (libstdc++'s fixed-size simd operators, which the float accurate mode and
+/// the rigid float fast mode's double lanes use) depends on a budget for the
+/// whole unit (--param inline-unit-growth): in units of a few loops they
+/// were called out of line, hundreds of calls in a loop, where the one
+/// object of every loop had inlined them all.
+#define COLLIDE_KERNEL_LOOP __attribute__((noinline, flatten))
+
+/// The table's index of model M (Model's order: particle, sphere, rigid).
+template <class M>
+inline constexpr std::size_t kModelSlot = std::is_same_v<M, ParticleModel> ? static_cast<std::size_t>(Model::particle)
+                                          : std::is_same_v<M, SphereModel> ? static_cast<std::size_t>(Model::sphere)
+                                                                           : static_cast<std::size_t>(Model::rigid);
+
+/// The job's bodies in the view of model M: its SoA view, or with kPacked
+/// its packed records.
+template <class M, bool kPacked, class T>
+COLLIDE_LANE_INLINE const auto& bodies_of(const KernelJob<T>& job) {
+  if constexpr (std::is_same_v<M, ParticleModel>) {
+    if constexpr (kPacked) {
+      return job.packed_particle;
+    } else {
+      return job.particle;
+    }
+  } else if constexpr (std::is_same_v<M, SphereModel>) {
+    if constexpr (kPacked) {
+      return job.packed_sphere;
+    } else {
+      return job.sphere;
+    }
+  } else {
+    if constexpr (kPacked) {
+      return job.packed_rigid;
+    } else {
+      return job.rigid;
+    }
+  }
 }
 
-/// A run of the job (solve_run_pieces), or its walk alone when its geometry
-/// is formed (KernelJob::stepped); the accurate mode and friction take the
-/// one-lane kernel, contact by contact.
-template <class T>
-void solve_run(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
-  if (job.accurate || job.friction) {
-    solve_range_scalar<T>(job, false, begin, end);
-    return;
+/// GroupLoops::solve: the law on groups of V::size() contacts.
+template <class M, class V, class Mode, bool kFriction, bool kPacked, class T = typename V::value_type>
+COLLIDE_KERNEL_LOOP std::size_t solve_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
+                                           std::size_t end) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked && job.friction == kFriction &&
+         job.accurate == (std::is_same_v<Mode, AccurateMode>)&&!job.stepped);
+  return solve_groups<M, V, kFriction, Mode, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.order,
+                                                contiguous, job.accumulate, begin, end);
+}
+
+/// GroupLoops::step: the velocity step of the job's contacts [begin, end),
+/// consecutive, whose geometry is formed (KernelJob::stepped), in groups of
+/// V::size().
+template <class M, class V, bool kPacked, class T = typename V::value_type>
+COLLIDE_KERNEL_LOOP std::size_t step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous, std::size_t begin,
+                                          std::size_t end) {
+  // Positions are contact indices: stepped jobs are prepared (identity order).
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.stepped && !job.accurate && !job.friction && (begin == end || job.order[begin] == begin));
+  constexpr std::size_t W = V::size();
+  const auto& bodies = bodies_of<M, kPacked>(job);
+  std::size_t i = begin;
+  for (; i + W <= end; i += W) {
+    step_group<M, V, T>(bodies, job.contacts, job.impulses, job.geometry, static_cast<std::uint32_t>(i),
+                        job.accumulate);
   }
-  with_view(job, [&](const auto& view, auto model) {
-    if (job.stepped) {
-      piece_walk<decltype(model), T>(view, job.contacts, job.impulses, job.accumulate, job.order + begin, end - begin,
-                                     job.geometry.from(begin));
-      return;
-    }
-    solve_run_pieces<decltype(model), SimdLanes<T>, T>(view, job.contacts, job.impulses, job.accumulate, job.order,
-                                                       begin, end);
-  });
+  return i;
+}
+
+/// KernelLoops::run: a run of the job in pieces (solve_run_pieces), its
+/// geometry in the lanes of this ISA.
+template <class M, class T, bool kPacked>
+COLLIDE_KERNEL_LOOP void run_loop(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(!job.accurate && !job.friction && !job.stepped);
+  solve_run_pieces<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate,
+                                       job.order, begin, end);
+}
+
+/// KernelLoops::geometry (RunGeometryKernel of kernel_table.hpp).
+template <class M, class T, bool kPacked>
+COLLIDE_KERNEL_LOOP void geometry_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                                       const GeometryView<T>& into) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(!job.accurate && !job.friction);
+  piece_geometry<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.order + first, count, into);
+}
+
+/// KernelLoops::walk (RunWalkKernel of kernel_table.hpp).
+template <class M, class T, bool kPacked>
+COLLIDE_KERNEL_LOOP void walk_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
+                                   const GeometryView<T>& geometry) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(!job.accurate && !job.friction);
+  piece_walk<M, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate, job.order + first, count,
+                   geometry);
+}
+
+/// Model M's solve slots of `loops` in mode Mode, in lanes V (an ISA's, or
+/// one lane): with and without friction, on both layouts.
+template <class M, class V, class Mode>
+void add_solve_loops(GroupLoops<typename V::value_type>& loops) {
+  auto& slots = loops.solve[kModelSlot<M>][std::is_same_v<Mode, AccurateMode> ? 1 : 0];
+  slots[0][0] = &solve_loop<M, V, Mode, false, false>;
+  slots[0][1] = &solve_loop<M, V, Mode, false, true>;
+  slots[1][0] = &solve_loop<M, V, Mode, true, false>;
+  slots[1][1] = &solve_loop<M, V, Mode, true, true>;
+}
+
+/// Model M's velocity-step slots of `loops`, in lanes V, on both layouts.
+template <class M, class V>
+void add_step_loops(GroupLoops<typename V::value_type>& loops) {
+  loops.step[kModelSlot<M>][0] = &step_loop<M, V, false>;
+  loops.step[kModelSlot<M>][1] = &step_loop<M, V, true>;
+}
+
+/// The slots of one kernel unit in the lanes of this ISA: model M's loops
+/// of precision T in mode Mode; the fast mode's unit also holds the loops
+/// that only the fast mode has (the velocity step and the run's).
+template <class M, class T, class Mode>
+void add_unit_loops(KernelLoops<T>& loops) {
+  add_solve_loops<M, SimdLanes<T>, Mode>(loops.groups);
+  if constexpr (std::is_same_v<Mode, FastMode>) {
+    constexpr std::size_t m = kModelSlot<M>;
+    add_step_loops<M, SimdLanes<T>>(loops.groups);
+    loops.run[m][0] = &run_loop<M, T, false>;
+    loops.run[m][1] = &run_loop<M, T, true>;
+    loops.geometry[m][0] = &geometry_loop<M, T, false>;
+    loops.geometry[m][1] = &geometry_loop<M, T, true>;
+    loops.walk[m][0] = &walk_loop<M, T, false>;
+    loops.walk[m][1] = &walk_loop<M, T, true>;
+  }
+}
+
+/// Model M's one-lane slots of `loops`: both modes, both layouts.
+template <class M, class T>
+void add_one_lane_loops(GroupLoops<T>& loops) {
+  add_solve_loops<M, ScalarLanes<T>, FastMode>(loops);
+  add_solve_loops<M, ScalarLanes<T>, AccurateMode>(loops);
+  add_step_loops<M, ScalarLanes<T>>(loops);
 }
 
 }  // namespace
 }  // namespace COLLIDE_KERNEL_NS
-
-#define COLLIDE_CONCAT_(a, b) a##b
-#define COLLIDE_CONCAT(a, b) COLLIDE_CONCAT_(a, b)
-
-namespace {
-
-/// The SIMD entry of this ISA: full groups in its lanes, the tail in the
-/// baseline's one lane.
-template <class T>
-void solve_range_simd(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
-  const std::size_t tail = solve_job_groups<SimdLanes<T>, T>(job, contiguous, begin, end);
-  if (tail < end) solve_range_scalar<T>(job, contiguous, tail, end);
-}
-
-Isa this_isa() {
-#if defined(COLLIDE_KERNEL_ISA_avx512)
-  return Isa::avx512;
-#elif defined(COLLIDE_KERNEL_ISA_avx2)
-  return Isa::avx2;
-#else
-  return Isa::sse2;
-#endif
-}
-
-}  // namespace
-
-const KernelTable& COLLIDE_CONCAT(kernel_table_, COLLIDE_KERNEL_NS)() {
-  static const KernelTable table{this_isa(),
-                                 SimdLanes<float>::size(),
-                                 SimdLanes<double>::size(),
-                                 &solve_range_simd<float>,
-                                 &solve_range_simd<double>,
-                                 &solve_run<float>,
-                                 &solve_run<double>,
-                                 &run_piece_geometry<float>,
-                                 &run_piece_geometry<double>,
-                                 &run_piece_walk<float>,
-                                 &run_piece_walk<double>};
-  return table;
-}
-
-#if defined(COLLIDE_KERNEL_ISA_sse2) || defined(COLLIDE_KERNEL_ISA_native)
-// The baseline object also holds the one-lane kernel.
-template <class T>
-void solve_range_scalar(const KernelJob<T>& job, bool contiguous, std::size_t begin, std::size_t end) {
-  [[maybe_unused]] const std::size_t stop = solve_job_groups<ScalarLanes<T>, T>(job, contiguous, begin, end);
-  assert(stop == end);
-}
-template void solve_range_scalar<float>(const KernelJob<float>&, bool, std::size_t, std::size_t);
-template void solve_range_scalar<double>(const KernelJob<double>&, bool, std::size_t, std::size_t);
-#endif
-
 }  // namespace collide::detail

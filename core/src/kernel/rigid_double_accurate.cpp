@@ -1,0 +1,15 @@
+// kernel/rigid_double_accurate.cpp - a kernel unit (kernel/units.hpp): the
+// rigid model's double loops of the accurate mode, in the lanes of the ISA it
+// is compiled for (kernel/loops.hpp; once per ISA, core/CMakeLists.txt).
+#include "kernel/loops.hpp"
+#include "kernel/units.hpp"
+
+namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
+
+void add_rigid_double_accurate(KernelTable& table) {
+  add_unit_loops<RigidModel, double, AccurateMode>(table.loops_double);
+}
+
+}  // namespace COLLIDE_KERNEL_NS
+}  // namespace collide::detail

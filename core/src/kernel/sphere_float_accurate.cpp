@@ -1,0 +1,15 @@
+// kernel/sphere_float_accurate.cpp - a kernel unit (kernel/units.hpp): the
+// sphere model's float loops of the accurate mode, in the lanes of the ISA it
+// is compiled for (kernel/loops.hpp; once per ISA, core/CMakeLists.txt).
+#include "kernel/loops.hpp"
+#include "kernel/units.hpp"
+
+namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
+
+void add_sphere_float_accurate(KernelTable& table) {
+  add_unit_loops<SphereModel, float, AccurateMode>(table.loops_float);
+}
+
+}  // namespace COLLIDE_KERNEL_NS
+}  // namespace collide::detail
