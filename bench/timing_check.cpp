@@ -195,8 +195,8 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
   // The benchmark's row.
   figures.push_back(bench_figure(bench_kind(kind), n, isa));
 
-  std::vector<double> seconds;
-  for (const Figure& f : figures) seconds.push_back(f.seconds);
+  std::vector<double> seconds(figures.size());
+  std::transform(figures.begin(), figures.end(), seconds.begin(), [](const Figure& f) { return f.seconds; });
   const double median = collide::median_seconds(seconds);
   bool ok = median > 0;
   for (const Figure& f : figures) {
