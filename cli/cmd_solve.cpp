@@ -14,16 +14,16 @@
 //   scene it accepted; if it did, the exception reaches main(), which prints
 //   "collide: <message>" and exits 1, and since no output is opened before
 //   the solve returns, nothing is written.
-// * kernel_seconds times Solver::solve alone (steady_clock), the number the
-//   project reports as throughput, less the ISA measurement that the first
-//   solve of a process runs with --isa auto (isa_calibration_seconds) and
-//   less the solver's allocate phase (allocate_seconds: the fresh Solver's
+// * kernel_seconds times Solver::solve alone (steady_clock), one first solve
+//   in a fresh process, with no warm-up (docs/report.md, "Timing"), less the
+//   ISA measurement that the first solve of a process runs with --isa auto
+//   (isa_calibration_seconds) and less the solver's allocate phase (allocate_seconds: the fresh Solver's
 //   buffers grown and their pages touched before its kernels run), both
 //   reported apart by solve_record; reading, scheduling and writing are timed
 //   separately, and io_seconds (read + write) with io_fraction (its share of
 //   read + schedule + solve + write, the solve's allocate phase included)
-//   say how much of a run is file I/O: for large scenes nearly all of it (2M
-//   bodies: seconds of CSV against milliseconds of kernel).
+//   say how much of a run is file I/O: for large CSV scenes nearly all of it
+//   (docs/decisions/0011-csv-scene-files.md).
 // * --check runs reference_solve<long double> on an exact copy of the inputs
 //   taken before the solve (convert_* copy without renormalising), in the
 //   solve's sequence (its schedule's order, --passes times), and
