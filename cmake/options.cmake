@@ -43,8 +43,9 @@ if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
     set(_collide_isas_here sse2 avx2)
   endif()
 endif()
-# COLLIDE_KERNEL_ISAS: which of them to build. Every kernel object costs a few
-# minutes of compile time; a project that embeds collide for known machines
+# COLLIDE_KERNEL_ISAS: which of them to build. Every ISA's kernel costs a few
+# minutes of compile time (in units of under a minute each,
+# core/src/kernel/units.hpp); a project that embeds collide for known machines
 # (or a test that needs only the library's packaging, tests/package) may
 # build fewer, e.g. -DCOLLIDE_KERNEL_ISAS="sse2;avx2". sse2 cannot be left
 # out: it is the baseline every x86-64 has and holds the scalar path.

@@ -1,6 +1,6 @@
 // kernel_table.hpp - the seam between the driver (solve.cpp, compiled for the
-// baseline) and the kernel's loops, compiled once per instruction set and
-// body model (kernel/loops.hpp).
+// baseline) and the kernel's loops (kernel/loops.hpp), compiled once per
+// instruction set in units of one body model, precision and accuracy mode.
 //
 // Design notes
 // ------------
@@ -123,9 +123,9 @@ using GroupLoop = std::size_t (*)(const KernelJob<T>& job, bool contiguous, std:
 template <class T>
 using RunKernel = void (*)(const KernelJob<T>& job, std::size_t begin, std::size_t end);
 
-/// Contacts per piece of a run (solve_run_pieces in kernel/loops.hpp): the geometry
-/// of a piece, 64 bytes a contact in float, stays in L1 between the pass that
-/// forms it and the walk that reads it.
+/// Contacts per piece of a run (solve_run_pieces in kernel/loops.hpp): the
+/// geometry of a piece, 64 bytes a contact in float, stays in L1 between the
+/// pass that forms it and the walk that reads it.
 inline constexpr std::size_t kRunPiece = 128;
 
 /// The geometry of a piece of a run, in arrays of its own.

@@ -31,7 +31,6 @@
 #include "collide/solve.hpp"
 #include "kernel_table.hpp"
 #include "support/scenes.hpp"
-#include "support/solve_helpers.hpp"
 
 namespace collide::test {
 namespace {
