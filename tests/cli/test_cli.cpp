@@ -105,10 +105,8 @@ class CliTest : public ::testing::Test {
     return collide::test::run_program(COLLIDE_CLI_PATH, dir_, args);
   }
 
-  /// Writes the scene files and runs solve on them with `extra` options.
-  RunResult solve(const std::string& bodies, const std::string& contacts, std::vector<std::string> extra = {}) const {
-    spit(path("bodies.csv"), bodies);
-    spit(path("contacts.csv"), contacts);
+  /// The arguments of solve on the scene files of solve() with `extra` options.
+  std::vector<std::string> solve_args(const std::vector<std::string>& extra = {}) const {
     std::vector<std::string> args = {"solve",
                                      "--bodies",
                                      path("bodies.csv").string(),
@@ -119,7 +117,14 @@ class CliTest : public ::testing::Test {
                                      "--out-impulses",
                                      path("oj.csv").string()};
     args.insert(args.end(), extra.begin(), extra.end());
-    return run(args);
+    return args;
+  }
+
+  /// Writes the scene files and runs solve on them with `extra` options.
+  RunResult solve(const std::string& bodies, const std::string& contacts, std::vector<std::string> extra = {}) const {
+    spit(path("bodies.csv"), bodies);
+    spit(path("contacts.csv"), contacts);
+    return run(solve_args(extra));
   }
 
   /// Files in the test directory other than the inputs (outputs, temporaries).
@@ -942,28 +947,15 @@ TEST_F(CliTest, UsageErrorsExitTwo) {
 TEST_F(CliTest, CountsStateTheirRange) {
   spit(path("bodies.csv"), kBodies);
   spit(path("contacts.csv"), kContacts);
-  const std::vector<std::string> scene = {"solve",
-                                          "--bodies",
-                                          path("bodies.csv").string(),
-                                          "--contacts",
-                                          path("contacts.csv").string(),
-                                          "--out-bodies",
-                                          path("ob.csv").string(),
-                                          "--out-impulses",
-                                          path("oj.csv").string()};
-  const auto with = [&](std::vector<std::string> extra) {
-    std::vector<std::string> args = scene;
-    args.insert(args.end(), extra.begin(), extra.end());
-    return args;
-  };
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
-      {with({"--passes", "-1"}), "collide solve: --passes must be an integer from 1 to 1000000, got '-1'\n"},
-      {with({"--passes", "0"}), "collide solve: --passes must be an integer from 1 to 1000000, got '0'\n"},
-      {with({"--passes", "1000001"}), "collide solve: --passes must be an integer from 1 to 1000000, got '1000001'\n"},
-      {with({"--passes", "2.5"}), "collide solve: --passes must be an integer from 1 to 1000000, got '2.5'\n"},
-      {with({"--threads", "-1"}), "collide solve: --threads must be an integer from 0 to 4096, got '-1'\n"},
-      {with({"--threads", "4097"}), "collide solve: --threads must be an integer from 0 to 4096, got '4097'\n"},
-      {with({"--order", "color"}),
+      {solve_args({"--passes", "-1"}), "collide solve: --passes must be an integer from 1 to 1000000, got '-1'\n"},
+      {solve_args({"--passes", "0"}), "collide solve: --passes must be an integer from 1 to 1000000, got '0'\n"},
+      {solve_args({"--passes", "1000001"}),
+       "collide solve: --passes must be an integer from 1 to 1000000, got '1000001'\n"},
+      {solve_args({"--passes", "2.5"}), "collide solve: --passes must be an integer from 1 to 1000000, got '2.5'\n"},
+      {solve_args({"--threads", "-1"}), "collide solve: --threads must be an integer from 0 to 4096, got '-1'\n"},
+      {solve_args({"--threads", "4097"}), "collide solve: --threads must be an integer from 0 to 4096, got '4097'\n"},
+      {solve_args({"--order", "color"}),
        "collide solve: --order: unknown order 'color' (expected input or colour): did you mean 'colour'?\n"},
       {{"gen", "--pairs", "0", "--out", path("g").string()},
        "collide gen: --pairs must be an integer from 1 to 2147483647, got '0'\n"},
@@ -990,7 +982,7 @@ TEST_F(CliTest, CountsStateTheirRange) {
   EXPECT_FALSE(fs::exists(path("ob.csv")));
   EXPECT_FALSE(fs::exists(path("b.npz")));
   // The least of each is accepted.
-  EXPECT_EQ(run(with({"--passes", "1", "--threads", "0"})).exit_code, 0);
+  EXPECT_EQ(run(solve_args({"--passes", "1", "--threads", "0"})).exit_code, 0);
   for (const char* kind : {"--pairs", "--debris", "--pile", "--chain"}) {
     const RunResult r = run({"gen", kind, "1", "--out", path(std::string("one") + kind).string()});
     EXPECT_EQ(r.exit_code, 0) << kind << ": " << r.err;
