@@ -12,7 +12,7 @@ namespace collide::detail {
 namespace {
 
 /// Parts of the largest span a task takes at least: 64 pages, 256 KiB.
-constexpr std::size_t kGrain = 64;
+constexpr std::size_t kPagesPerTask = 64;
 
 std::uintptr_t page_of(const unsigned char* p) {
   return reinterpret_cast<std::uintptr_t>(p) / FirstTouch::kPage * FirstTouch::kPage;
@@ -55,7 +55,7 @@ void FirstTouch::run(tbb::task_arena& arena) {
   for (std::size_t s = 0; s < count_; ++s) parts = std::max(parts, pages(spans_[s].p, spans_[s].bytes));
   arena.execute([&] {
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, parts, kGrain),
+        tbb::blocked_range<std::size_t>(0, parts, kPagesPerTask),
         [&](const tbb::blocked_range<std::size_t>& r) {
           // Parts [begin, end) of `parts` are the same fraction of every span.
           for (std::size_t s = 0; s < count_; ++s) {
