@@ -338,6 +338,15 @@ TYPED_TEST(Validate, PackedRecordsGetTheVerdictOfTheirSoAView) {
   EXPECT_NE(validate(no_masses, f.contacts, f.impulses).message.find("bodies.inv_mass is null"), std::string::npos);
 }
 
+/// A copy of x[0, n) followed by `tail` zeros, so that a view starting
+/// inside the copy ends inside the buffer as well.
+template <class T>
+std::vector<T> with_tail(const T* x, std::size_t n, std::size_t tail) {
+  std::vector<T> out(n + tail, T(0));
+  std::copy(x, x + n, out.begin());
+  return out;
+}
+
 // Arrays the solve writes (v, w, the impulses, records) may share no byte
 // with another array of the solve; the message names both, and says which
 // one the solve writes.
@@ -353,8 +362,12 @@ TYPED_TEST(Validate, WrittenArraysShareNoMemory) {
     EXPECT_EQ(message(sphere_view(f.bodies), f), "bodies.v.x and bodies.w.x share memory: the solve writes both");
   }
   {
+    // Overlapping, not equal: p.x moved into a buffer with room for v.y,
+    // three elements on, to end inside it.
     Fixture<T> f;
-    f.bodies.v.y = f.bodies.p.x + 3;  // overlapping, not equal
+    std::vector<T> px = with_tail(f.bodies.p.x, f.bodies.count, 3);
+    f.bodies.p.x = px.data();
+    f.bodies.v.y = px.data() + 3;
     EXPECT_EQ(f.run().message,
               "bodies.p.x and bodies.v.y share memory: the solve writes bodies.v.y while it reads bodies.p.x");
     EXPECT_EQ(message(particle_view(f.bodies), f), "") << "a particle solve reads no p";
@@ -365,7 +378,9 @@ TYPED_TEST(Validate, WrittenArraysShareNoMemory) {
     EXPECT_EQ(f.run().message,
               "contacts.n.x and impulses.j.z share memory: the solve writes impulses.j.z while it reads contacts.n.x");
     Fixture<T> g;
-    g.impulses.j.y = g.bodies.w.z + 1;
+    std::vector<T> wz = with_tail(g.bodies.w.z, g.bodies.count, g.impulses.count + 1);
+    g.bodies.w.z = wz.data();
+    g.impulses.j.y = wz.data() + 1;
     EXPECT_EQ(g.run().message, "bodies.w.z and impulses.j.y share memory: the solve writes both");
   }
   {
