@@ -147,7 +147,10 @@ bool body_ok(const BodyRecord<T>& body) noexcept {
   // other value finite.
   const std::array<T, 17> v = body_values(body);
   bool ok = true;
-  for (std::size_t k = 0; k <= kLastMoment; ++k) ok &= (v[k] > T(0)) & std::isfinite(T(1) / v[k]);
+  for (std::size_t k = 0; k <= kLastMoment; ++k) {
+    ok &= v[k] > T(0);
+    ok &= static_cast<bool>(std::isfinite(T(1) / v[k]));
+  }
   for (std::size_t k = kLastMoment + 1; k < v.size(); ++k) ok &= static_cast<bool>(std::isfinite(v[k]));
   return ok && quaternion_fault(body.q) == QuaternionFault::none;
 }

@@ -9,8 +9,10 @@
 //   to count its calls) and none of detail::allocate_large (its own count),
 //   in the input and the colour order, with one pass and four (the stepped
 //   path of prepared_contacts.hpp), in float and double, on SoA input solved
-//   in place and packed into the solver's buffer. Nor does a smaller solve
-//   after it, or the same size again after the smaller one.
+//   in place and packed into the solver's buffer (a pile of 20,000 contacts;
+//   and one of 600,000, whose arrays take huge pages, in the colour order
+//   with four passes, packed). Nor does a smaller solve after it, or the
+//   same size again after the smaller one.
 // * The counts can fail: the first solve of a fresh Solver in the colour
 //   order, or packed, does allocate (its prepared contacts, its records).
 // * allocate_seconds is finite and positive for a solve that sized the
@@ -19,6 +21,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
+#include <initializer_list>
 #include <new>
 #include <string>
 
@@ -78,16 +81,32 @@ struct Allocations {
   }
 };
 
-/// A pile of about 600,000 contacts: prepared arrays of megabytes, past the
-/// huge-page size of allocate_large.
-template <class T>
-const Scene<T>& pile() {
+/// A pile of about `contacts` contacts, generated once per size.
+template <class T, std::size_t kContacts>
+const Scene<T>& pile_of() {
   static const Scene<T> scene = [] {
     GenerateOptions o;
     o.seed = 3;
-    return generate_pile<T>(pile_side_for_contacts(600000), o);
+    return generate_pile<T>(pile_side_for_contacts(kContacts), o);
   }();
   return scene;
+}
+
+/// About 600,000 contacts: prepared arrays of megabytes, past the huge-page
+/// size of allocate_large.
+template <class T>
+const Scene<T>& pile() {
+  return pile_of<T, 600000>();
+}
+
+/// About 20,000 contacts: every buffer of the solver, in arrays below the
+/// huge-page size. Allocations are counted the same way at either size, so
+/// the choices of order, passes and layout are walked on this one, and the
+/// large pile checks the huge-page arrays in one choice (its solves are
+/// most of this test's time, under the sanitizers most of all).
+template <class T>
+const Scene<T>& small_pile() {
+  return pile_of<T, 20000>();
 }
 
 std::string describe(Order order, int passes, BodyLayout layout) {
@@ -95,11 +114,11 @@ std::string describe(Order order, int passes, BodyLayout layout) {
 }
 
 template <class T>
-void check_reuse_allocates_nothing() {
-  const Scene<T>& original = pile<T>();
-  for (const Order order : {Order::input, Order::colour}) {
-    for (const int passes : {1, 4}) {
-      for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
+void check_reuse_allocates_nothing(const Scene<T>& original, std::initializer_list<Order> orders,
+                                   std::initializer_list<int> pass_counts, std::initializer_list<BodyLayout> layouts) {
+  for (const Order order : orders) {
+    for (const int passes : pass_counts) {
+      for (const BodyLayout layout : layouts) {
         SCOPED_TRACE(describe(order, passes, layout));
         Scene<T> scene = original;
         const ContactView<T> contacts = scene.contacts.view();
@@ -150,6 +169,17 @@ void check_reuse_allocates_nothing() {
       }
     }
   }
+}
+
+template <class T>
+void check_reuse_allocates_nothing() {
+  {
+    SCOPED_TRACE("a pile of 20,000 contacts");
+    check_reuse_allocates_nothing(small_pile<T>(), {Order::input, Order::colour}, {1, 4},
+                                  {BodyLayout::soa, BodyLayout::packed});
+  }
+  SCOPED_TRACE("a pile of 600,000 contacts");
+  check_reuse_allocates_nothing(pile<T>(), {Order::colour}, {4}, {BodyLayout::packed});
 }
 
 TEST(SolverAllocations, ASecondSolveAllocatesNothingInFloat) { check_reuse_allocates_nothing<float>(); }
