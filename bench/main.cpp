@@ -17,6 +17,7 @@
 //                    --timing-dir=DIR (scene files; default a temporary one),
 //                    --timing-scenes=KIND:N,... (default pairs:1e6,pairs:4e6,
 //                    debris:1e6,pile:2980000), --timing-runs=R (3),
+//                    --timing-rounds=K (3: alternated rounds, medians),
 //                    --timing-tolerance=F (0.1). Exit 1 when they disagree.
 // Any --benchmark_filter gets "|^triad/" appended so that the bound is always
 // measured. The console table is tabular unless --benchmark_counters_tabular=
@@ -74,6 +75,12 @@ Options parse_own_flags(int& argc, char** argv) {
       options.timing.runs = std::atoi(arg.c_str() + 14);
       if (options.timing.runs < 1 || options.timing.runs > 1000) {
         std::fprintf(stderr, "collide_bench: --timing-runs must be from 1 to 1000, got '%s'\n", arg.c_str() + 14);
+        std::exit(2);
+      }
+    } else if (arg.rfind("--timing-rounds=", 0) == 0) {
+      options.timing.rounds = std::atoi(arg.c_str() + 16);
+      if (options.timing.rounds < 1 || options.timing.rounds > 1000) {
+        std::fprintf(stderr, "collide_bench: --timing-rounds must be from 1 to 1000, got '%s'\n", arg.c_str() + 16);
         std::exit(2);
       }
     } else if (arg.rfind("--timing-tolerance=", 0) == 0) {

@@ -28,6 +28,9 @@ struct TimingCheckOptions {
   /// --timing-runs=R: timed runs of the report's figures, and processes of
   /// `collide solve`.
   int runs = 3;
+  /// --timing-rounds=K: alternated rounds of the instruments; each
+  /// instrument's figure is the median of its K rounds.
+  int rounds = 3;
   /// --timing-tolerance=F: the largest relative distance of a figure from
   /// the scene's median that passes.
   double tolerance = 0.10;

@@ -22,6 +22,10 @@
 //   larger than the last-level cache starts every solve from cold caches
 //   (its label says so). The check prints each instrument's figure and its
 //   distance from the median, so that such a difference shows.
+// * The instruments take turns: `rounds` rounds, each instrument measuring
+//   once a round, and each instrument's figure the median of its rounds. On
+//   a machine whose speed drifts (other guests of the host), instruments
+//   run one after another would each meet a different machine.
 // * A scene passes when every figure is within `tolerance` of the median
 //   of the scene's figures. Timings move with the machine's load: the check
 //   prints the load average, and is worth running only on an idle machine.
@@ -35,6 +39,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -111,6 +116,7 @@ Kind bench_kind(const std::string& kind) {
 /// Benchmark in this process.
 Figure bench_figure(Kind kind, std::size_t n, collide::Isa isa) {
   const std::string name = isa_name(kind, "f32", isa, kThreads, n);
+  benchmark::ClearRegisteredBenchmarks();  // a round registers the row again
   benchmark::RegisterBenchmark(
       name.c_str(), [=](benchmark::State& s) { solve_row<float>(s, kind, n, collide::Path::simd, kThreads, isa); })
       ->UseManualTime()
@@ -151,6 +157,12 @@ Figure solve_figure(const std::string& collide, const std::filesystem::path& dir
                 "kernel_seconds, median of " + std::to_string(seconds.size()) + " processes"};
 }
 
+/// One instrument: its name, and how it measures one figure.
+struct Instrument {
+  std::string name;
+  std::function<Figure()> measure;
+};
+
 /// Runs the check of one scene; true when it passed.
 bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOptions& options,
                  const std::string& collide, const std::filesystem::path& root, std::ostream& out) {
@@ -160,7 +172,6 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
   const std::size_t n = pile ? collide::pile_contact_count(side) : asked;
   out << kind << " n=" << n << (pile ? " (" + std::to_string(side) + "^3 boxes)" : std::string()) << "\n";
   out.flush();
-  std::vector<Figure> figures;
 
   // `collide solve` on the files of `collide gen`.
   const std::filesystem::path dir = root / (kind + "-" + std::to_string(n));
@@ -171,29 +182,54 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
     out << "  collide gen failed: " << gen << "\n" << output;
     return false;
   }
-  figures.push_back(solve_figure(collide, dir, isa, options.runs, out));
-  std::error_code ec;
-  std::filesystem::remove_all(dir, ec);
 
-  // The report's kernel row and, for pairs, its sweep at the same N.
   collide::ReportOptions report;
   report.n = report.debris_n = report.pile_n = asked;
   report.threads = {kThreads};
   report.runs = options.runs;
   report.seed = 1;
-  const collide::ReportRow row = collide::measure_kernel_speed(report, kind);
-  figures.push_back(Figure{"report kernel row", row.seconds,
-                           std::to_string(row.runs) + " runs after a warm-up; " + row.isa + ", " + row.layout});
+  std::vector<Instrument> instruments;
+  instruments.push_back({"collide solve --stats", [&] { return solve_figure(collide, dir, isa, options.runs, out); }});
+  // The report's kernel row and, for pairs, its sweep at the same N.
+  instruments.push_back({"report kernel row", [&] {
+                           const collide::ReportRow row = collide::measure_kernel_speed(report, kind);
+                           return Figure{
+                               "report kernel row", row.seconds,
+                               std::to_string(row.runs) + " runs after a warm-up; " + row.isa + ", " + row.layout};
+                         }});
   if (kind == "pairs") {
-    report.sweep_n = {n};
-    const std::vector<collide::SweepPoint> sweep = collide::measure_sweep_report(report, "rigid");
-    const double rate = sweep.empty() ? 0 : sweep.front().collisions_per_second;
-    figures.push_back(Figure{"report sweep", rate > 0 ? static_cast<double>(n) / rate : 0,
-                             std::to_string(sweep.empty() ? 0 : sweep.front().runs) + " runs after a warm-up"});
+    instruments.push_back(
+        {"report sweep", [&] {
+           collide::ReportOptions sweep_options = report;
+           sweep_options.sweep_n = {n};
+           const std::vector<collide::SweepPoint> sweep = collide::measure_sweep_report(sweep_options, "rigid");
+           const double rate = sweep.empty() ? 0 : sweep.front().collisions_per_second;
+           return Figure{"report sweep", rate > 0 ? static_cast<double>(n) / rate : 0,
+                         std::to_string(sweep.empty() ? 0 : sweep.front().runs) + " runs after a warm-up"};
+         }});
   }
+  instruments.push_back({"collide_bench row", [&] { return bench_figure(bench_kind(kind), n, isa); }});
 
-  // The benchmark's row.
-  figures.push_back(bench_figure(bench_kind(kind), n, isa));
+  // Rounds alternate the instruments, each measuring once a round, so that
+  // the machine's drift over the check falls on all of them alike; each
+  // instrument's figure is the median of its rounds.
+  std::vector<std::vector<double>> rounds(instruments.size());
+  std::vector<Figure> figures(instruments.size());
+  for (int r = 0; r < options.rounds; ++r) {
+    for (std::size_t i = 0; i < instruments.size(); ++i) {
+      const Figure f = instruments[i].measure();
+      if (f.seconds > 0) rounds[i].push_back(f.seconds);
+      figures[i] = f;
+    }
+  }
+  for (std::size_t i = 0; i < instruments.size(); ++i) {
+    figures[i].seconds = rounds[i].size() == static_cast<std::size_t>(options.rounds)
+                             ? collide::median_seconds(rounds[i])
+                             : 0;  // a round without a figure fails the scene
+    figures[i].detail += "; median of " + std::to_string(rounds[i].size()) + " alternated rounds";
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
 
   std::vector<double> seconds(figures.size());
   std::transform(figures.begin(), figures.end(), seconds.begin(), [](const Figure& f) { return f.seconds; });
