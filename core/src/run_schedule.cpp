@@ -65,6 +65,11 @@ class Walk {
     wait_for(step.first_item + step.items);
   }
 
+  /// The passes run, once every thread has returned from work().
+  [[nodiscard]] std::size_t passes() const {
+    return schedule_.batch_count() == 0 ? plan_.passes : passes_.load(std::memory_order_relaxed);
+  }
+
  private:
   [[nodiscard]] std::size_t size(std::size_t k) const {
     return schedule_.batch_begin(k + 1) - schedule_.batch_begin(k);
@@ -97,13 +102,15 @@ class Walk {
     finished_.fetch_add(1, std::memory_order_acq_rel);
   }
 
-  /// The step after `s`; false after the last.
-  bool next_step(Step& s) const {
+  /// The step after `s`; false after the last, and at the end of a pass
+  /// once the stop flag is set.
+  bool next_step(Step& s) {
     std::size_t k = s.end_batch;
     std::size_t pass = s.pass;
     const std::size_t batches = schedule_.batch_count();
     if (k == batches) {
-      if (++pass >= plan_.passes || batches == 0) return false;
+      if (++pass >= plan_.passes || batches == 0 || stopped()) return false;
+      started(pass);
       k = 0;
     }
     Step next;
@@ -132,6 +139,15 @@ class Walk {
     const std::size_t per_item = ((end - begin + s.items - 1) / s.items + w - 1) / w * w;
     const std::size_t b = begin + item * per_item;
     if (b < end) kernels_.range(job, consecutive(k), b, std::min(end, b + per_item));
+  }
+
+  [[nodiscard]] bool stopped() const { return plan_.stop != nullptr && plan_.stop->load(std::memory_order_relaxed); }
+
+  /// Counts pass `pass` (from 0) as started: this thread runs it to its end.
+  void started(std::size_t pass) {
+    std::size_t seen = passes_.load(std::memory_order_relaxed);
+    while (seen < pass + 1 && !passes_.compare_exchange_weak(seen, pass + 1, std::memory_order_relaxed)) {
+    }
   }
 
   /// Batch k's contacts are consecutive in the job's arrays.
@@ -197,6 +213,7 @@ class Walk {
   KernelJob<T> later_;           // the passes after: J added
   std::array<std::atomic<std::uint64_t>, kMaxItems> stamps_{};
   std::atomic<std::uint64_t> finished_{0};
+  std::atomic<std::size_t> passes_{1};  // passes a thread has started (the first is every thread's)
   std::atomic<PipelinedRun<T>*> run_{nullptr};
   std::atomic<int> helping_{0};
 };
@@ -204,14 +221,14 @@ class Walk {
 }  // namespace
 
 template <class T>
-void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena, const KernelJob<T>& job,
-                   const Schedule& schedule) {
-  arena.execute([&] {
+std::size_t walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena,
+                          const KernelJob<T>& job, const Schedule& schedule) {
+  return arena.execute([&] {
     const int threads = std::max(1, arena.max_concurrency());
     Walk<T> walk(table, plan, threads, job, schedule);
     if (threads == 1) {
       walk.work(0);
-      return;
+      return walk.passes();
     }
     // The other threads are tasks of the arena: one that starts late finds
     // its items claimed, and one that never starts is run by wait() once
@@ -220,12 +237,13 @@ void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_are
     for (int t = 1; t < threads; ++t) helpers.run([&walk, t] { walk.work(t); });
     walk.work(0);
     helpers.wait();
+    return walk.passes();
   });
 }
 
-template void walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&, const KernelJob<float>&,
-                                   const Schedule&);
-template void walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&, const KernelJob<double>&,
-                                    const Schedule&);
+template std::size_t walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                          const KernelJob<float>&, const Schedule&);
+template std::size_t walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                           const KernelJob<double>&, const Schedule&);
 
 }  // namespace collide::detail

@@ -12,6 +12,11 @@
 //   hand-off between its batches (in it, a stretch of batches smaller than
 //   the lanes is a run, resolved contact after contact by the run kernel).
 //   Items are numbered across the steps and passes.
+// * A stop flag (SolverOptions::stop) is read by each thread as it reaches
+//   the end of a pass, once per pass: a thread that reads it set walks no
+//   further, and one that read it clear claims every item of the next pass
+//   the others leave, so the walk always ends on a whole pass, whichever
+//   threads saw the flag when. The walk counts the passes started.
 // * The threads of the arena start once per solve and walk the steps
 //   together. Before it claims an item of a step, a thread waits until every
 //   item of the earlier steps has finished: a counter of finished items,
@@ -36,6 +41,7 @@
 //   items to the others.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 
 #include <oneapi/tbb/task_arena.h>
@@ -51,6 +57,9 @@ struct WalkPlan {
   std::size_t width = 1;   ///< lanes of the kernel that runs
   std::size_t block = 1;   ///< contacts per item of a large batch (a multiple of width)
   std::size_t passes = 1;  ///< times the schedule is walked; J is summed over them
+  /// Read at the end of each pass but the last; once set, no pass starts
+  /// (SolverOptions::stop). Null: every pass runs.
+  const std::atomic<bool>* stop = nullptr;
   /// The job's contacts are in the schedule's order (prepared_contacts.hpp):
   /// every batch's contacts are consecutive in its arrays.
   bool prepared = false;
@@ -58,14 +67,15 @@ struct WalkPlan {
 
 /// Resolves every contact of `schedule` `plan.passes` times with `job`'s
 /// kernels from `table`, on the threads of `arena`. The first pass writes J,
-/// the later ones add to it.
+/// the later ones add to it. Returns the passes run: plan.passes, or fewer
+/// when plan.stop was set (at least one; plan.passes for an empty schedule).
 template <class T>
-void walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena, const KernelJob<T>& job,
-                   const Schedule& schedule);
+std::size_t walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena,
+                          const KernelJob<T>& job, const Schedule& schedule);
 
-extern template void walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
-                                          const KernelJob<float>&, const Schedule&);
-extern template void walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
-                                           const KernelJob<double>&, const Schedule&);
+extern template std::size_t walk_schedule<float>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                                 const KernelJob<float>&, const Schedule&);
+extern template std::size_t walk_schedule<double>(const KernelTable&, const WalkPlan&, tbb::task_arena&,
+                                                  const KernelJob<double>&, const Schedule&);
 
 }  // namespace collide::detail

@@ -173,6 +173,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   plan.width = plan.simd ? detail::of_precision<T>(table.lanes_float, table.lanes_double) : 1;
   plan.block = std::max<std::size_t>(plan.width, (options.block + plan.width - 1) / plan.width * plan.width);
   plan.passes = static_cast<std::size_t>(options.passes);
+  plan.stop = options.stop;
+  std::size_t passes = 0;
   if (detail::prepares_contacts(schedule)) {
     // Copied in, walked every pass, J copied out: the copies cost two
     // streaming passes, the gathers they spare one per colour. With several
@@ -186,10 +188,10 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const detail::KernelJob<T> on_prepared =
         prepared_contacts.prepare(*arena, job, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
     plan.prepared = true;
-    detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
+    passes = detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());
   } else {
-    detail::walk_schedule(table, plan, *arena, job, schedule);
+    passes = detail::walk_schedule(table, plan, *arena, job, schedule);
   }
 
   SolveStats stats;
@@ -212,7 +214,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.order = schedule.ordering();
   stats.colours = schedule.colours();
   stats.overflow_contacts = schedule.overflow_contacts();
-  stats.passes = plan.passes;
+  stats.passes = passes;
   return stats;
 }
 

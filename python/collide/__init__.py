@@ -151,7 +151,10 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     or the records, and ``out``) may share memory with another of its arrays
     (ValueError naming both). For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
-    solving. Bad input raises TypeError or ValueError and modifies nothing.
+    solving; Ctrl-C on the main thread stops a solve of several passes after
+    the pass in progress with KeyboardInterrupt, v, w and ``out`` as the
+    passes done left them (docs/python.md, "Stopping a long solve"). Bad
+    input raises TypeError or ValueError and modifies nothing.
 
     ``check=False`` skips the full validation of the values (a pass over every
     array, about as long as the solve itself at 1M pairs) and the model-fit

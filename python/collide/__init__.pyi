@@ -153,7 +153,9 @@ class Solver:
     ) -> None:
         """``threads`` from 0 (all) to 4096 and ``passes`` from 1 to 1000000,
         as the command's options: TypeError for a value that is not an
-        integer, ValueError outside the range."""
+        integer, ValueError outside the range. Ctrl-C stops a solve of
+        several passes on the main thread after the pass in progress
+        (KeyboardInterrupt; the arrays as the passes done left them)."""
     def __repr__(self) -> str: ...
     def solve(
         self,

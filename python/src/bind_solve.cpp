@@ -25,10 +25,16 @@
 //   allocate phase, which have keys of their own), the error per contact is
 //   collide::impulse_errors_eps, what `--check` summarises, and the
 //   conservation drifts are collide::conservation_drift, the report's.
+// * Ctrl-C stops a solve of several passes after the pass in progress
+//   (interrupt.hpp): each Solver has a stop flag (SolverOptions::stop) that
+//   a SIGINT sets while the main thread solves; a solve that ran fewer
+//   passes than asked raises KeyboardInterrupt, v, w and `out` as the passes
+//   done left them.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -46,6 +52,7 @@
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/isa.hpp"
+#include "interrupt.hpp"
 #include "packed_bodies.hpp"
 #include "scene.hpp"
 
@@ -141,11 +148,18 @@ py::dict to_dict(const StatRecord& record) {
 }
 
 struct PySolver {
+  /// The solver's SolverOptions::stop, set by Ctrl-C (interrupt.hpp).
+  std::unique_ptr<std::atomic<bool>> stop = std::make_unique<std::atomic<bool>>(false);
   std::unique_ptr<Solver> solver;
 
   PySolver(const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
            const std::string& order, const py::object& passes)
-      : solver(std::make_unique<Solver>(solver_options(path, threads, isa, accuracy, order, passes))) {}
+      : solver(std::make_unique<Solver>(stoppable(solver_options(path, threads, isa, accuracy, order, passes)))) {}
+
+  SolverOptions stoppable(SolverOptions o) const {
+    o.stop = stop.get();
+    return o;
+  }
 
   template <class T, class B>
   py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
@@ -194,11 +208,18 @@ struct PySolver {
     SolveStats stats;
     double kernel_seconds = 0;
     {
-      py::gil_scoped_release release;
-      const auto t0 = Clock::now();
-      stats = run_solve<T>(*solver, model, bodies, cv, jv, schedule->schedule);
-      kernel_seconds = seconds_since(t0);
+      // One pass has nothing to stop between.
+      std::optional<InterruptOnSigint> interruptible;
+      if (solver->options().passes > 1) interruptible.emplace(*stop);
+      {
+        py::gil_scoped_release release;
+        const auto t0 = Clock::now();
+        stats = run_solve<T>(*solver, model, bodies, cv, jv, schedule->schedule);
+        kernel_seconds = seconds_since(t0);
+      }
     }
+    const auto asked = static_cast<std::size_t>(solver->options().passes);
+    if (stats.passes < asked) raise_interrupted(stats.passes, asked);
     // impacts=False: no pass over J (at a million contacts it costs 5-10% of
     // a particle solve); the record is built over no impulses and the key
     // set to None.
@@ -354,6 +375,7 @@ class ThreadLimit {
 };
 
 void register_solve(py::module_& m) {
+  prepare_interrupts();
   py::class_<PySchedule>(m, "Schedule")
       .def(py::init(&PySchedule::make<Bodies>), py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("order") = "input")
@@ -437,6 +459,25 @@ void register_solve(py::module_& m) {
                " scene: J, v, w and impulse_scale in float64)";
       });
 
+  // The options of collide.solve checked and normalised as it checks them,
+  // without a Solver (no threads, no CPU check of the ISA): what
+  // collide.dask checks on the client before its tasks run collide.solve.
+  m.def(
+      "solve_options",
+      [](const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
+         const std::string& order, const py::object& passes) {
+        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes);
+        py::dict d;
+        d["path"] = to_string(o.path);
+        d["threads"] = o.threads;
+        d["isa"] = o.isa == Isa::automatic ? py::object(py::none()) : py::object(py::str(to_string(o.isa)));
+        d["accuracy"] = to_string(o.accuracy);
+        d["order"] = to_string(o.order);
+        d["passes"] = o.passes;
+        return d;
+      },
+      py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
+      py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1);
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
         py::arg("order") = "input", py::arg("passes") = 1, py::arg("schedule") = nullptr);
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));

@@ -8,7 +8,8 @@
 //   (bind_scene.cpp), packed records (bind_packed.cpp), solving, schedules,
 //   the reference and the instruction sets (bind_solve.cpp), the islands of
 //   a scene (bind_islands.cpp), scene files
-//   (bind_files.cpp), the report (bind_report.cpp). The collide package
+//   (bind_files.cpp), the report (bind_report.cpp); Ctrl-C during a solve
+//   (interrupt.hpp) serves bind_solve.cpp. The collide package
 //   (python/collide/__init__.py) gives the public functions their Python
 //   signatures and documentation over these.
 // * The rules are the library's: validate() for arrays in kernel units,

@@ -20,15 +20,23 @@
 //   bound, for one pass and for four.
 // * passes = k is bitwise k solves with their J added in turn, in both
 //   orders.
+// * A stop flag (SolverOptions::stop) ends a solve on a whole pass: set
+//   before the solve, after the first; set by another thread during a long
+//   solve, soon, with v, w and J bitwise a solve of the passes it reports,
+//   in both orders, with friction and without, on 1 to 3 threads and both
+//   body layouts.
 // * Immovable bodies are never changed, and a NaN in one contact changes
 //   nothing outside the contacts and bodies it reaches in solve order.
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <numeric>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -466,6 +474,91 @@ TEST(Passes, AreThatManySolvesWithTheirImpulsesAdded) {
       }
     }
   }
+}
+
+/// A solve of `scene` with `o` (a copy of its bodies), and its stats.
+template <class T>
+std::pair<std::pair<BodyBuffer<T>, ImpulseBuffer<T>>, SolveStats> solve_with_stats(const Scene<T>& scene,
+                                                                                   const SolverOptions& o) {
+  BodyBuffer<T> bodies = scene.bodies;
+  const ContactView<T> c = scene.contacts.view();
+  ImpulseBuffer<T> j(c.count);
+  Schedule schedule(o.order);
+  schedule.build(c, bodies.view());
+  const SolveStats stats = Solver(o).solve(Model::rigid, bodies.view(), c, j.view(), schedule);
+  return {{std::move(bodies), std::move(j)}, stats};
+}
+
+TEST(Passes, AStopSetBeforeTheSolveEndsItAfterThePassInProgress) {
+  const Scene<float> scene = make_scene<float>(Kind::pile, 20000, false);
+  const std::atomic<bool> stop{true};
+  for (const Order order : {Order::input, Order::colour}) {
+    SCOPED_TRACE(to_string(order));
+    SolverOptions o = options_for(Path::simd, 2, 128);
+    o.order = order;
+    const auto [want, want_stats] = solve_with_stats(scene, o);  // one pass
+    o.passes = 1000;
+    o.stop = &stop;
+    const auto [got, stats] = solve_with_stats(scene, o);
+    EXPECT_EQ(stats.passes, 1u);
+    EXPECT_TRUE(same_impulses(got.second, want.second));
+    EXPECT_TRUE(same_bodies(got.first, want.first));
+  }
+}
+
+TEST(Passes, AStopSetDuringTheSolveLeavesTheWholePassesItReports) {
+  const tbb::global_control workers(tbb::global_control::max_allowed_parallelism, 4);
+  constexpr int kPasses = 100000;  // minutes without the stop
+  for (const Order order : {Order::input, Order::colour}) {
+    for (const bool friction : {false, true}) {
+      const Scene<float> scene = make_scene<float>(Kind::pile, 20000, friction);
+      for (const int threads : {1, 2, 3}) {
+        for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
+          SCOPED_TRACE(std::string(to_string(order)) + (friction ? " friction, " : ", ") + std::to_string(threads) +
+                       " threads, " + to_string(layout));
+          std::atomic<bool> stop{false};
+          SolverOptions o = options_for(Path::simd, threads, 128);
+          o.order = order;
+          o.layout = layout;
+          o.passes = kPasses;
+          o.stop = &stop;
+          std::thread stopper([&stop] {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            stop.store(true);
+          });
+          const auto t0 = std::chrono::steady_clock::now();
+          const auto [got, stats] = solve_with_stats(scene, o);
+          const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          stopper.join();
+          ASSERT_GE(stats.passes, 1u);
+          ASSERT_LT(stats.passes, static_cast<std::size_t>(kPasses));
+          EXPECT_LT(seconds, 10.0);
+          // The same bits as a solve of that many passes, run to its end.
+          o.passes = static_cast<int>(stats.passes);
+          o.stop = nullptr;
+          const auto [want, want_stats] = solve_with_stats(scene, o);
+          EXPECT_EQ(want_stats.passes, stats.passes);
+          EXPECT_TRUE(same_impulses(got.second, want.second));
+          EXPECT_TRUE(same_bodies(got.first, want.first));
+        }
+      }
+    }
+  }
+}
+
+TEST(Passes, AClearStopRunsEveryPass) {
+  const Scene<float> scene = make_scene<float>(Kind::debris, 20000, true);
+  const std::atomic<bool> stop{false};
+  SolverOptions o = options_for(Path::simd, 2, 128);
+  o.order = Order::colour;
+  o.passes = 3;
+  const auto [want, want_stats] = solve_with_stats(scene, o);
+  o.stop = &stop;
+  const auto [got, stats] = solve_with_stats(scene, o);
+  EXPECT_EQ(stats.passes, 3u);
+  EXPECT_EQ(want_stats.passes, 3u);
+  EXPECT_TRUE(same_impulses(got.second, want.second));
+  EXPECT_TRUE(same_bodies(got.first, want.first));
 }
 
 TEST(Passes, ZeroIsRefused) {

@@ -1,6 +1,8 @@
 """collide.dask on a real LocalCluster (2 worker processes of one thread):
 the same bytes as collide.solve, scenes given as arrays or as binary scene
-files, the partitions, the giant-island warning, solve_scenes' table, the
+files, both orders with one pass and several (the colour order through the
+whole scene's solve order), collide.solve's errors for bad options, the
+partitions, the giant-island warning, solve_scenes' table, the
 command, bad input, a worker killed mid-run, and `import collide` without
 Dask.
 
@@ -61,6 +63,23 @@ def island_scene(model="rigid", dtype=np.float64, seed=1, friction=True, piles=6
         parts.append(collide.generate("pile", 2 + k % 2, model=model, friction=friction, seed=seed + k, dtype=dtype))
         parts.append(collide.generate("debris", 30, model=model, friction=friction, seed=seed + 50 + k, dtype=dtype))
     parts.append(collide.generate("pairs", 60, model=model, friction=friction, seed=seed + 99, dtype=dtype))
+    return interleaved(parts, seed, friction)
+
+
+def piles_scene(dtype=np.float32, seed=1, friction=True, piles=4, n=20):
+    """Piles of n^3 boxes on one ground, their contacts interleaved by a
+    seeded shuffle: more contacts than one window of the colour order
+    (Schedule's 65,536), so that each pile's contacts fall into every
+    window, and into other windows in a partition of the scene than in the
+    whole scene."""
+    parts = [collide.generate("pile", n, friction=friction, seed=seed + k, dtype=dtype) for k in range(piles)]
+    return interleaved(parts, seed, friction)
+
+
+def interleaved(parts, seed, friction):
+    """The scenes ``parts`` as one: bodies concatenated, every immovable
+    body replaced by the first one in the contacts, the contacts shuffled by
+    a seeded permutation."""
     offsets = np.cumsum([0] + [len(b) for b, _ in parts])
     fields = {f: np.concatenate([getattr(b, f) for b, _ in parts], axis=-1) for f in FIELDS}
     a = np.concatenate([c.a + o for (_, c), o in zip(parts, offsets)]).astype(np.uint32)
@@ -114,6 +133,108 @@ def test_arrays_same_bytes_as_collide_solve(client, model, dtype, accuracy):
     assert len(solution.stats["partitions"]) == 2 and sum(solution.stats["partitions"]) == len(contacts)
     for key in ("kernel_seconds", "allocate_seconds"):  # the partitions' solves, summed
         assert np.isfinite(solution.stats[key]) and solution.stats[key] >= 0, (key, solution.stats)
+
+
+@pytest.mark.parametrize("order", ["input", "colour"])
+@pytest.mark.parametrize("passes", [1, 4])
+def test_order_and_passes_same_bytes_as_collide_solve(client, order, passes):
+    bodies, contacts = piles_scene(seed=3)
+    isl = collide.islands(bodies, contacts)
+    assert len(contacts) > 65_536 and isl.count == 4, (len(contacts), isl.count)
+    expected = reference_bytes(bodies, contacts, order=order, passes=passes)
+    assert (expected[3]["order"], expected[3]["passes"]) == (order, passes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cd.IslandWarning)
+        solution = cd.solve((bodies, contacts), client, order=order, passes=passes)
+    same_bytes(solution, expected)
+    assert (solution.stats["order"], solution.stats["passes"]) == (order, passes)
+    assert len(solution.stats["partitions"]) == 2
+
+
+def test_a_partitions_own_colour_order_would_not_be_the_scenes(client):
+    # What the client's solve order is for: a partition (two of the four
+    # piles) solved alone in its own colour order differs from the whole
+    # scene's solve, since its contacts fall into other windows.
+    from collide.dask import _tasks
+
+    bodies, contacts = piles_scene(seed=3)
+    expected = reference_bytes(bodies, contacts, order="colour", passes=2)
+    isl = collide.islands(bodies, contacts)
+    rows = np.flatnonzero(isl.labels < 2)
+    part_bodies, part_contacts, ids = _tasks.sub_scene(bodies, contacts, rows)
+    J, _ = collide.solve(part_bodies, part_contacts, order="colour", passes=2)
+    whole = np.frombuffer(expected[0], dtype=np.float32).reshape(3, -1)
+    assert J.tobytes() != np.ascontiguousarray(whole[:, rows]).tobytes()
+    # The same rows in the whole scene's solve order, solved in input order: the whole's bits.
+    in_order = collide.Schedule(bodies, contacts, order="colour").solve_order()
+    in_order = in_order[np.isin(in_order, rows)].astype(np.int64)
+    part_bodies, part_contacts, ids = _tasks.sub_scene(bodies, contacts, in_order)
+    J, _ = collide.solve(part_bodies, part_contacts, passes=2)
+    assert J.tobytes() == np.ascontiguousarray(whole[:, in_order]).tobytes()
+
+
+@pytest.mark.parametrize("order, passes", [("colour", 3), ("input", 2)])
+def test_scene_files_in_an_order_with_passes(client, tmp_path, order, passes):
+    bodies, contacts = piles_scene(np.float64, seed=5, friction=False)
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    expected = reference_bytes(*collide.load(bp, cp), order=order, passes=passes)
+    solution = cd.solve((bp, cp), client, out_dir=tmp_path / "out", order=order, passes=passes, partitions=3)
+    same_bytes(solution, expected)
+    assert sorted(os.listdir(tmp_path / "out")) == ["J.npy", "v.npy", "w.npy"]
+    # The command: the same options, the same bytes.
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "cmd"), "--scheduler", client.scheduler.address,
+                "--order", order, "--passes", str(passes), "--no-progress")
+    assert r.returncode == 0, r.stderr
+    stats = json.loads(r.stdout)
+    assert (stats["order"], stats["passes"]) == (order, passes)
+    same_bytes(cd.Solution(*(np.load(tmp_path / "cmd" / f"{k}.npy") for k in "Jvw"), {}), expected)
+
+
+def collide_solve_error(**options):
+    """The exception collide.solve raises for these options (its type and message)."""
+    with pytest.raises((TypeError, ValueError)) as e:
+        collide.solve(*collide.generate("pairs", 10), **options)
+    return type(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("options", [{"passes": 0}, {"passes": 10**9}, {"passes": 2.5}, {"order": "color"},
+                                     {"order": "random"}, {"accuracy": "exact"}, {"threads": -1},
+                                     {"isa": "avx9"}])
+def test_bad_options_get_collide_solves_errors(client, tmp_path, options):
+    kind, message = collide_solve_error(**options)
+    scene = collide.generate("pairs", 10)
+    v = scene[0].v.copy()
+    with pytest.raises(kind) as e:
+        cd.solve(scene, client, **options)
+    assert str(e.value) == message
+    assert scene[0].v.tobytes() == v.tobytes(), "nothing written"
+    with pytest.raises(kind) as e:
+        cd.solve_scenes([{"kind": "pairs", "n": 10}], client, **options)
+    assert str(e.value) == message
+
+
+def test_the_command_refuses_bad_passes_with_collide_solves_message(client, tmp_path):
+    bp, cp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz")
+    collide.save(bp, cp, *collide.generate("pairs", 10))
+    _, message = collide_solve_error(passes=0)
+    for command in (["solve", bp, cp, "--out-dir", str(tmp_path / "out")], ["scenes", bp, cp]):
+        r = run_cli(*command, "--passes", "0", "--scheduler", client.scheduler.address)
+        assert r.returncode == 1 and r.stderr == f"collide-dask: error: {message}\n", r.stderr
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "out"), "--order", "color")
+    assert r.returncode == 2 and "invalid choice: 'color'" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_solve_scenes_in_an_order_with_passes(client):
+    scenes = [{"kind": "pile", "n": 8, "seed": 2}, {"kind": "debris", "n": 20_000, "seed": 3, "friction": True},
+              {"kind": "pairs", "n": 5000}]
+    table = cd.solve_scenes(scenes, client, order="colour", passes=4, sample=1000)
+    assert list(table["contacts"]) == [len(collide.generate(**s)[1]) for s in scenes]
+    assert list(table["error_sample"]) == [1000, 1000, 1000]
+    assert (table["collisions_per_second"] > 0).all()
+    assert (table["max_error_eps"] <= collide.error_bound_eps).all(), table["max_error_eps"]
+    assert (table["momentum_drift"].abs() < 1e-4).all(), table["momentum_drift"]
 
 
 def test_grouping_and_forced_model_do_not_change_the_bytes(client):
@@ -233,7 +354,8 @@ def test_a_partition_task_alone_writes_its_rows(tmp_path, elsewhere):
     np.save(tmp_path / "order.npy", order)
     common = {"bodies_path": bp, "contacts_path": cp, "body_count": len(bodies), "dtype": "float64", "friction": False,
               "outputs": outputs, "client_machine": "another kernel" if elsewhere else _tasks.machine()}
-    options = {"model": expected[3]["model"], "accuracy": "fast", "threads": 1, "isa": None}
+    options = cd._options(expected[3]["model"], threads=1)
+    assert options["solve"] == {"accuracy": "fast", "order": "input", "passes": 1, "threads": 1, "isa": None}
     _tasks.solve_part_files(dict(common, order=None, first=0, end=50), options)
     _tasks.solve_part_files(dict(common, order=str(tmp_path / "order.npy"), first=0, end=len(order)), options)
     same_bytes(cd.Solution(*(np.load(outputs[k]) for k in "Jvw"), {}), expected)
@@ -442,8 +564,10 @@ def test_bad_input(client, tmp_path):
         cd.solve((contacts, bodies), client)
     with pytest.raises(ValueError, match="model 'particle' does not fit"):
         cd.solve(collide.generate("pairs", 10), client, model="particle")
-    with pytest.raises(ValueError, match="accuracy must be"):
+    with pytest.raises(ValueError, match=r"^unknown accuracy 'exact' \(expected fast or accurate\)$"):
         cd.solve(collide.generate("pairs", 10), client, accuracy="exact")
+    with pytest.raises(ValueError, match=r"^collide.dask.solve_scenes: scene 0: unknown accuracy 'exact'"):
+        cd.solve_scenes([{"kind": "pairs", "n": 10, "accuracy": "exact"}], client)
 
     # Files: the reader's message (file, row, column), no output.
     bodies, contacts = collide.generate("pairs", 100, dtype=np.float64)

@@ -34,6 +34,23 @@ def test_passes_says_its_range(value, error):
         collide.reference_solve(bodies, contacts, passes=value)
 
 
+def test_passes_above_the_tools_limit_get_the_tools_message(cli, tmp_path):
+    # One limit (collide::kMaxPasses), one message: the tool's, in Python's
+    # terms (the keyword's name, the value as Python shows it).
+    bodies, contacts = small_scene()
+    collide.save(str(tmp_path / "b.npz"), str(tmp_path / "c.npz"), bodies, contacts)
+    for value in (0, 1_000_001, 10**9):
+        r = subprocess.run([cli, "solve", "--bodies", str(tmp_path / "b.npz"), "--contacts", str(tmp_path / "c.npz"),
+                            "--passes", str(value)], capture_output=True, text=True)
+        assert r.returncode == 2
+        tool = r.stderr.splitlines()[0]
+        assert tool == f"collide solve: --passes must be an integer from 1 to 1000000, got '{value}'", tool
+        with pytest.raises(ValueError) as python:
+            collide.solve(bodies, contacts, passes=value)
+        assert str(python.value) == tool.replace("collide solve: --", "").replace(f"'{value}'", str(value))
+    assert collide.solve(bodies, contacts, passes=1_000_000, threads=1)[1]["passes"] == 1_000_000
+
+
 def test_counts_accept_python_and_numpy_integers():
     assert collide.Solver(passes=np.int64(3), threads=np.int32(1)).passes == 3
     assert collide.Solver(passes=1_000_000).passes == 1_000_000

@@ -8,6 +8,7 @@
 // order: input order, or the colour order collide chooses (schedule.hpp).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <memory>
 
@@ -84,6 +85,15 @@ struct SolverOptions {
   /// same bits as that many solves with their J added in turn (every NaN
   /// the canonical one). The schedule serves every pass.
   int passes = 1;
+  /// A flag the solve's threads read between passes, never inside one: once
+  /// it reads true, a solve ends with the pass in progress, v, w and J as
+  /// the passes done left them (SolveStats::passes says how many). For a
+  /// caller that stops a long solve from another thread or a signal handler
+  /// (Ctrl-C: std::atomic<bool> is lock-free, so a handler may set it); it
+  /// must outlive the solves, and it stops every solve running on the
+  /// Solver. Null (the default): every pass runs. One relaxed load per pass
+  /// and thread: no cost in the kernels.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// The most passes the `collide` tool (--passes) and the Python module
@@ -123,7 +133,9 @@ struct SolveStats {
   Order order = Order::input;         ///< the schedule's order
   std::size_t colours = 0;            ///< the colour order: Schedule::colours()
   std::size_t overflow_contacts = 0;  ///< the colour order: Schedule::overflow_contacts()
-  std::size_t passes = 1;             ///< SolverOptions::passes
+  /// Passes run: SolverOptions::passes, or fewer when SolverOptions::stop
+  /// ended the solve (at least 1).
+  std::size_t passes = 1;
 };
 
 /// Number of lanes of the SIMD path for T under default_isa() (COLLIDE_ISA,

@@ -44,7 +44,7 @@ GIANT_ISLAND_SHARE = 0.5
 
 class IslandWarning(UserWarning):
     """The largest island holds most of the scene's contacts: it is solved on
-    one worker, in input order, whatever the number of workers."""
+    one worker, in its solve order, whatever the number of workers."""
 
 
 class Solution(NamedTuple):
@@ -116,14 +116,18 @@ def _wait(futures, progress, what):
     return [f.result() for f in futures]
 
 
-def _options(model, accuracy, threads, isa, sample=0):
-    if accuracy not in ("fast", "accurate"):
-        raise ValueError(f"accuracy must be 'fast' or 'accurate', got {accuracy!r}")
+def _options(model, sample=0, **solve):
+    """The options of the tasks: ``model``, ``sample``, ``threads`` (the
+    task's share of the machine, _tasks.on_its_threads) and ``solve``, the
+    keywords every task passes to collide.solve (accuracy, order, passes,
+    threads, isa), checked and normalised by the library as collide.solve
+    checks them, with its messages (the ISA's name only: the workers' CPUs
+    decide whether they have it)."""
     if model not in ("auto", "rigid", "sphere", "particle"):
         raise ValueError(f"model must be 'auto', 'rigid', 'sphere' or 'particle', got {model!r}")
-    if int(threads) < 0:
-        raise ValueError(f"threads must be >= 0, got {threads}")
-    return {"model": model, "accuracy": accuracy, "threads": int(threads), "isa": isa, "sample": int(sample)}
+    checked = collide._collide.solve_options(**solve)
+    del checked["path"]
+    return {"model": model, "sample": int(sample), "threads": checked["threads"], "solve": checked}
 
 
 def _scene_model(bodies, contacts, model, loaded):
@@ -144,8 +148,18 @@ def _scene_model(bodies, contacts, model, loaded):
 
 def _prepare(bodies, contacts, options, loaded=False):
     """What the client does before any task: checks the scene and chooses
-    its model, computes its islands and warns about a giant one. Returns the
-    options of the tasks, the islands, their figures and their time."""
+    its model, computes its islands, warns about a giant one, and in the
+    colour order finds the whole scene's solve order. Returns the options of
+    the tasks, the islands, their figures, their time and the solve order
+    (None: the input order).
+
+    A partition's contacts are solved in input order, in the sequence its
+    rows are given: the scene's order, or in the colour order the whole
+    scene's solve order (Schedule.solve_order). A colour order of the
+    partition alone would differ wherever an island spans other windows of
+    contacts than in the whole scene; the whole scene's sequence solved in
+    input order is the colour-order solve, bit for bit (the law applied
+    sequentially, docs/collision-law.md, "The solve order")."""
     task = dict(options, model=_scene_model(bodies, contacts, options["model"], loaded))
     t = time.perf_counter()
     isl = collide.islands(bodies, contacts)
@@ -154,7 +168,12 @@ def _prepare(bodies, contacts, options, loaded=False):
     share = isl.largest / m if m else 0.0
     figures = {"islands": isl.count, "largest_island": isl.largest, "largest_island_share": share}
     _warn_if_giant(figures, m, stacklevel=5)
-    return task, isl, figures, islands_seconds
+    solve_order = None
+    if options["solve"]["order"] != "input":
+        task["solve"] = dict(options["solve"], order="input")
+        if isl.largest > 1:  # else no two contacts share a movable body: every order is the input's
+            solve_order = collide.Schedule(bodies, contacts, order=options["solve"]["order"]).solve_order()
+    return task, isl, figures, islands_seconds, solve_order
 
 
 def _warn_if_giant(figures, contacts, stacklevel):
@@ -162,15 +181,17 @@ def _warn_if_giant(figures, contacts, stacklevel):
         warnings.warn(IslandWarning(
             f"collide.dask.solve: the largest island holds {figures['largest_island']:,} of {contacts:,} contacts "
             f"({100 * figures['largest_island_share']:.0f}%; {figures['islands']:,} islands): it is solved on one "
-            "worker, in input order, so distributing this scene gains little"), stacklevel=stacklevel)
+            "worker, in its solve order, so distributing this scene gains little"), stacklevel=stacklevel)
 
 
-def _partitions(isl, requested, client):
-    """The contacts grouped by partition, ascending inside each (the scene's
-    order), and the contacts of each partition and where its group ends:
-    ``(order, counts, ends)``. ``order`` is None when the groups are already
-    in the scene's order (partition 0 the first contacts, and so on: a scene
-    of many small islands), so that positions in it are contact rows."""
+def _partitions(isl, requested, client, solve_order=None):
+    """The contacts grouped by partition, each group in the sequence its
+    partition solves them (ascending, the scene's order, or the whole
+    scene's ``solve_order``), and the contacts of each partition and where
+    its group ends: ``(order, counts, ends)``. ``order`` is None when the
+    groups are already in the scene's order (partition 0 the first contacts,
+    and so on: a scene of many small islands in input order), so that
+    positions in it are contact rows."""
     p = requested if requested is not None else max(1, sum(client.nthreads().values()))
     if int(p) < 1:
         raise ValueError(f"partitions must be >= 1, got {p}")
@@ -188,6 +209,8 @@ def _partitions(isl, requested, client):
     contact_part = island_part.astype(dtype)[isl.labels]
     counts = np.bincount(contact_part, minlength=used)
     ends = np.cumsum(counts)
+    if solve_order is not None:
+        return solve_order[np.argsort(contact_part[solve_order], kind="stable")].astype(np.int64), counts, ends
     if len(contact_part) < 2 or bool(np.all(contact_part[1:] >= contact_part[:-1])):
         return None, counts, ends
     return np.argsort(contact_part, kind="stable"), counts, ends
@@ -195,12 +218,12 @@ def _partitions(isl, requested, client):
 
 def _rows(order, count, end):
     """The contact rows of the partition whose group ends at position
-    ``end`` of ``order``: a slice where they are consecutive, else an
-    int64 array."""
+    ``end`` of ``order``, in the sequence they are solved: a slice where
+    they are consecutive and ascending, else an int64 array."""
     if order is None:
         return slice(int(end - count), int(end))
     rows = order[end - count:end]
-    if int(rows[-1]) - int(rows[0]) == count - 1:
+    if int(rows[-1]) - int(rows[0]) == count - 1 and (count < 2 or bool(np.all(np.diff(rows) == 1))):
         return slice(int(rows[0]), int(rows[0]) + int(count))
     return rows
 
@@ -210,8 +233,8 @@ def _is_scene_files(scene):
         isinstance(x, (str, os.PathLike)) for x in scene)
 
 
-def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", dtype=None, threads=1, isa=None,
-          out_dir=None, workers=None, progress=False):
+def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", order="input", passes=1, dtype=None,
+          threads=1, isa=None, out_dir=None, workers=None, progress=False):
     """Solves one scene on Dask workers, island by island; the same bytes as
     :func:`collide.solve` on one machine. Returns a :class:`Solution` ``(J,
     v, w, stats)``.
@@ -235,9 +258,12 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     the grouping never changes the result. Each partition runs
     :func:`collide.solve` with the model chosen for the whole scene
     (``model``: "auto", "rigid", "sphere", "particle"), ``accuracy``
-    ("fast" or "accurate"), ``threads`` solver threads per task (default 1:
-    one per Dask thread) and ``isa``. A task lost with its worker is run
-    again by Dask, writing the same bytes.
+    ("fast" or "accurate"), ``passes``, ``threads`` solver threads per task
+    (default 1: one per Dask thread) and ``isa``, in the whole scene's
+    ``order`` ("input" or "colour": for the colour order the client finds
+    the scene's solve order and each partition solves its contacts in it).
+    Bad values of these raise collide.solve's errors. A task lost with its
+    worker is run again by Dask, writing the same bytes.
 
     ``client``: a ``distributed.Client``, a scheduler address, or None (the
     default client of this process, else a LocalCluster of ``workers``
@@ -249,8 +275,8 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     warns with :class:`IslandWarning` when the largest island holds more than
     ``GIANT_ISLAND_SHARE`` of the contacts. ``stats``: collisions, bodies,
     islands, largest_island, largest_island_share, partitions (their contact
-    counts), model, precision, accuracy, call_seconds (the whole call, wall
-    time), kernel_seconds (the partitions' solves, summed),
+    counts), model, precision, accuracy, order, passes, call_seconds (the
+    whole call, wall time), kernel_seconds (the partitions' solves, summed),
     collisions_per_second (collisions / kernel_seconds: the kernels'
     throughput, as collide.solve reports it), allocate_seconds (the allocate
     phases of those solves, summed: each task's one-shot solver grows its
@@ -259,7 +285,7 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     its worker, read to write), islands_seconds, and for files read_seconds
     (the load and check on the client) and outputs (the three paths)."""
     started = time.perf_counter()
-    options = _options(model, accuracy, threads, isa)
+    options = _options(model, accuracy=accuracy, order=order, passes=passes, threads=threads, isa=isa)
     if _is_scene_files(scene):
         if out_dir is None:
             raise ValueError("collide.dask.solve: scene files need out_dir, where the workers write J, v and w")
@@ -287,7 +313,8 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
     kernel_seconds = sum(r["kernel_seconds"] for r in results)
     return {"collisions": collisions, "bodies": body_count, **figures, "partitions": [int(c) for c in counts if c],
             "model": scene_model, "precision": "float" if precision == np.float32 else "double",
-            "accuracy": options["accuracy"], "call_seconds": time.perf_counter() - started,
+            "accuracy": options["solve"]["accuracy"], "order": options["solve"]["order"],
+            "passes": options["solve"]["passes"], "call_seconds": time.perf_counter() - started,
             "kernel_seconds": kernel_seconds,
             "collisions_per_second": collisions / kernel_seconds if kernel_seconds > 0 else 0.0,
             "allocate_seconds": sum(r["allocate_seconds"] for r in results),
@@ -297,9 +324,9 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
 def _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started):
     if bodies.dtype != contacts.dtype:
         raise TypeError(f"bodies are {bodies.dtype} but contacts are {contacts.dtype}: one precision per solve")
-    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options)
+    task, isl, figures, islands_seconds, solve_order = _prepare(bodies, contacts, options)
     with _connected(client, workers) as c:
-        order, counts, ends = _partitions(isl, partitions, c)
+        order, counts, ends = _partitions(isl, partitions, c, solve_order)
         parts, futures = [], []
         key = f"collide-dask-part-{uuid.uuid4().hex}"
         with warnings.catch_warnings():
@@ -337,7 +364,7 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
     t = time.perf_counter()
     bodies, contacts = collide.load(bodies_path, contacts_path, dtype=dtype)
     read_seconds = time.perf_counter() - t
-    task, isl, figures, islands_seconds = _prepare(bodies, contacts, options, loaded=True)
+    task, isl, figures, islands_seconds, solve_order = _prepare(bodies, contacts, options, loaded=True)
     os.makedirs(out_dir, exist_ok=True)
     out_dir = os.path.abspath(out_dir)
     final = {k: os.path.join(out_dir, f"{k}.npy") for k in ("J", "v", "w")}
@@ -362,14 +389,14 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
         common = {"bodies_path": bodies_path, "contacts_path": contacts_path, "body_count": n, "dtype": precision.name,
                   "friction": contacts.mu is not None, "outputs": partial, "client_machine": _tasks.machine()}
         with _connected(client, workers) as c:
-            order, counts, ends = _partitions(isl, partitions, c)
+            order, counts, ends = _partitions(isl, partitions, c, solve_order)
             # A partition of consecutive contacts (a scene of independent
             # pairs: all of them) is sent as its range of rows; the others
             # read their rows from an order file beside the outputs.
             rows = [_rows(order, count, e) if count else None for count, e in zip(counts, ends)]
             if any(isinstance(r, np.ndarray) for r in rows):
                 np.save(order_path, order.astype(np.uint32))
-            del bodies, contacts, isl, order, unnamed
+            del bodies, contacts, isl, order, unnamed, solve_order
             key = f"collide-dask-part-{uuid.uuid4().hex}"
             futures = []
             for p, (count, e, r) in enumerate(zip(counts, ends, rows)):
@@ -430,13 +457,16 @@ def _entry(i, item):
             raise ValueError(f"{where}: kind must be 'pairs', 'debris' or 'pile', got {entry['kind']!r}")
         entry.setdefault("name", " ".join(f"{k}={entry[k]}" for k in ("kind", "n", "seed", "model", "friction",
                                                                        "shuffle", "dtype") if k in entry))
-    if entry.get("accuracy", "fast") not in ("fast", "accurate"):
-        raise ValueError(f"{where}: accuracy must be 'fast' or 'accurate', got {entry['accuracy']!r}")
+    if "accuracy" in entry:
+        try:
+            entry["accuracy"] = collide._collide.solve_options(accuracy=entry["accuracy"])["accuracy"]
+        except (TypeError, ValueError) as e:
+            raise type(e)(f"{where}: {e}") from None
     return entry
 
 
-def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", sample=10_000, threads=1, isa=None,
-                 workers=None, progress=False):
+def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="input", passes=1, sample=10_000,
+                 threads=1, isa=None, workers=None, progress=False):
     """Solves many scenes, one task each, and measures each against the
     reference; returns a pandas DataFrame, one row per scene in the order
     given, columns ``SCENE_COLUMNS``: scene (its name), model (the one that
@@ -452,18 +482,22 @@ def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", sample=1
     "accuracy"), read by the worker, or the parameters of
     :func:`collide.generate` as a dict ("kind", "n", and optionally "seed",
     "model", "friction", "shuffle", "dtype", "name", "accuracy"), generated
-    on the worker, so nothing is stored. The sample is the scene's first
-    ``sample`` contacts, as ``collide report`` samples: solved alone it gives
-    the whole solve's first impulses (checked), and it is compared with
-    :func:`collide.reference_solve`. ``model``, ``accuracy``, ``threads``
-    (solver threads per task), ``isa``, ``client``, ``workers`` and
-    ``progress`` as for :func:`solve`.
+    on the worker, so nothing is stored. Each scene is solved whole by
+    :func:`collide.solve` with ``model``, ``accuracy``, ``order``,
+    ``passes``, ``threads`` (solver threads per task) and ``isa``; the
+    sample is the scene's first ``sample`` contacts, as ``collide report``
+    samples, solved alone with the same options and compared with
+    :func:`collide.reference_solve` replaying them. In input order with one
+    pass the sample's impulses are the whole solve's first ones (checked);
+    in the colour order, or with several passes, the contacts after the
+    sample change them, and the sample measures the solver on a scene of
+    its own. ``client``, ``workers`` and ``progress`` as for :func:`solve`.
 
     An entry that is not understood raises before anything runs (naming the
     entry); a scene file that is bad raises the reader's error (file, row,
     column)."""
     pandas = _need("pandas")
-    options = _options(model, accuracy, threads, isa, sample)
+    options = _options(model, sample, accuracy=accuracy, order=order, passes=passes, threads=threads, isa=isa)
     if options["sample"] < 0:
         raise ValueError(f"sample must be >= 0, got {sample}")
     entries = [_entry(i, item) for i, item in enumerate(scenes)]

@@ -11,6 +11,7 @@ from .. import Bodies, Contacts
 FloatArray = npt.NDArray[np.float32] | npt.NDArray[np.float64]
 ModelName = Literal["auto", "rigid", "sphere", "particle"]
 AccuracyName = Literal["fast", "accurate"]
+OrderName = Literal["input", "colour"]
 IsaName = Literal["sse2", "avx2", "avx512"]
 PathLike = str | os.PathLike[str]
 # A distributed.Client, a scheduler address, or None.
@@ -35,6 +36,8 @@ def solve(
     partitions: int | None = None,
     model: ModelName = "auto",
     accuracy: AccuracyName = "fast",
+    order: OrderName = "input",
+    passes: int = 1,
     dtype: type[np.float32] | type[np.float64] | np.dtype[Any] | None = None,
     threads: int = 1,
     isa: IsaName | None = None,
@@ -48,6 +51,8 @@ def solve_scenes(
     *,
     model: ModelName = "auto",
     accuracy: AccuracyName = "fast",
+    order: OrderName = "input",
+    passes: int = 1,
     sample: int = 10000,
     threads: int = 1,
     isa: IsaName | None = None,

@@ -38,6 +38,9 @@ def _parser():
                        help="start a LocalCluster of N single-threaded worker processes (default: all cores)")
     common.add_argument("--model", default="auto", choices=("auto", "rigid", "sphere", "particle"))
     common.add_argument("--accuracy", default="fast", choices=("fast", "accurate"))
+    common.add_argument("--order", default="input", choices=("input", "colour"),
+                        help="the solve order, as collide.solve's order= (default input)")
+    common.add_argument("--passes", type=int, default=1, help="passes over the contacts in that order (default 1)")
     common.add_argument("--threads", type=int, default=1, help="solver threads per task (default 1)")
     common.add_argument("--isa", default=None, choices=("sse2", "avx2", "avx512"))
     common.add_argument("--no-progress", action="store_true", help="no progress on stderr")
@@ -99,6 +102,11 @@ def _write_atomically(path, text):
         raise
 
 
+def _solve_options(args):
+    """The options both subcommands pass on as collide.solve's keywords."""
+    return {k: getattr(args, k) for k in ("model", "accuracy", "order", "passes", "threads", "isa")}
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     print(f"collide-dask: warning: {message}", file=sys.stderr)
 
@@ -116,14 +124,12 @@ def main(argv=None):
         progress = not args.no_progress
         if args.command == "solve":
             dtype = {"float": np.float32, "double": np.float64, None: None}[args.precision]
-            solution = cd.solve((args.bodies, args.contacts), client, partitions=args.partitions, model=args.model,
-                                accuracy=args.accuracy, dtype=dtype, threads=args.threads, isa=args.isa,
-                                out_dir=args.out_dir, workers=workers, progress=progress)
+            solution = cd.solve((args.bodies, args.contacts), client, partitions=args.partitions, dtype=dtype,
+                                out_dir=args.out_dir, workers=workers, progress=progress, **_solve_options(args))
             print(json.dumps(solution.stats))
         else:
-            table = cd.solve_scenes(_scene_entries(args.inputs), client, model=args.model, accuracy=args.accuracy,
-                                    sample=args.sample, threads=args.threads, isa=args.isa, workers=workers,
-                                    progress=progress)
+            table = cd.solve_scenes(_scene_entries(args.inputs), client, sample=args.sample, workers=workers,
+                                    progress=progress, **_solve_options(args))
             csv = table.to_csv(index=False)
             if args.out:
                 _write_atomically(args.out, csv)

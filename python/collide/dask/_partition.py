@@ -1,9 +1,9 @@
 """Islands grouped into partitions balanced by contact count (NumPy only).
 
 The grouping decides only which worker solves which islands: every island is
-solved whole, its contacts in input order, so the result does not depend on
-it (docs/distributed.md). It is deterministic, so that a run can be
-repeated and explained:
+solved whole, its contacts in the scene's solve order, so the result does
+not depend on it (docs/distributed.md). It is deterministic, so that a run
+can be repeated and explained:
 
 1. Large islands (more than an eighth of the mean partition) first, largest
    first (ties: the lower label), each onto the least loaded partition (ties:

@@ -3,7 +3,8 @@
 called (and tested) without Dask; the workers import them by name.
 
 A partition is a set of whole islands. It is solved as a scene of its own:
-its contacts in input order, its bodies (every body its contacts name,
+its contacts in input order, in the sequence the client gives them (the
+scene's order, or the whole scene's colour order), its bodies (every body its contacts name,
 immovable ones included) in ascending index order, the contacts' indices
 remapped to them. Islands never see each other's results, so the impulses
 and the velocities of its movable bodies are bit for bit those of one solve
@@ -57,8 +58,8 @@ def local_bodies(a, b):
 
 
 def sub_scene(bodies, contacts, rows):
-    """Contacts ``rows`` (ascending) of a scene of arrays and the bodies they
-    name, as a new scene over copies: ``(Bodies, Contacts, body_ids)``."""
+    """Contacts ``rows`` (in that order) of a scene of arrays and the bodies
+    they name, as a new scene over copies: ``(Bodies, Contacts, body_ids)``."""
     a, b = contacts.a[rows], contacts.b[rows]
     ids, la, lb = local_bodies(a, b)
     if isinstance(ids, slice):
@@ -91,9 +92,9 @@ def on_its_threads(task):
 
 def _solve(bodies, contacts, options):
     """collide.solve of an already checked scene (the client ran the checks
-    on the whole scene and chose the model there)."""
-    return collide.solve(bodies, contacts, model=options["model"], accuracy=options["accuracy"],
-                         threads=options["threads"], isa=options["isa"], check=False, impacts=False)
+    on the whole scene and chose the model there) with the task's solve
+    keywords."""
+    return collide.solve(bodies, contacts, model=options["model"], **options["solve"], check=False, impacts=False)
 
 
 def _part_stats(stats, contacts, bodies, started, read_seconds):
@@ -211,22 +212,24 @@ def scene_of(entry):
 def scene_row(entry, options):
     """Solves one scene on the worker and measures it: the row of
     ``solve_scenes``. The error and the drifts are measured on the scene's
-    first ``sample`` contacts, as ``collide report`` measures its rows: the
-    law applies contacts in input order, so those contacts' impulses are the
-    same with or without the ones after them. The sample is solved on its
-    own with the model the whole scene ran (its impulses equal the whole
-    solve's first ones) and compared with the long double reference."""
-    accuracy = entry.get("accuracy", options["accuracy"])
+    first ``sample`` contacts, as ``collide report`` measures its rows,
+    solved on their own with the model and the options the whole scene ran
+    and compared with the long double reference replaying its order and
+    passes. In input order with one pass the law applies contacts in input
+    order, so the sample's impulses are the same with or without the
+    contacts after them: they equal the whole solve's first ones (checked).
+    In the colour order, or with several passes, the contacts after the
+    sample change those, and the sample is a scene of its own."""
+    solve = dict(options["solve"], accuracy=entry.get("accuracy", options["solve"]["accuracy"]))
     bodies, contacts = scene_of(entry)
     isl = collide.islands(bodies, contacts, threads=options["threads"])
     k = min(options["sample"], len(contacts))
     sample_bodies, sample_contacts, _ = sub_scene(bodies, contacts, np.arange(k))
-    J, stats = collide.solve(bodies, contacts, model=options["model"], accuracy=accuracy, threads=options["threads"],
-                             isa=options["isa"])
-    ref = collide.reference_solve(sample_bodies, sample_contacts)
-    J_sample, _ = collide.solve(sample_bodies, sample_contacts, model=stats["model"], accuracy=accuracy,
-                                threads=options["threads"], isa=options["isa"])
-    if J_sample.tobytes() != np.ascontiguousarray(J[:, :k]).tobytes():
+    J, stats = collide.solve(bodies, contacts, model=options["model"], **solve)
+    ref = collide.reference_solve(sample_bodies, sample_contacts, order=solve["order"], passes=solve["passes"])
+    J_sample, _ = collide.solve(sample_bodies, sample_contacts, model=stats["model"], **solve)
+    alone_is_whole = solve["order"] == "input" and solve["passes"] == 1
+    if alone_is_whole and J_sample.tobytes() != np.ascontiguousarray(J[:, :k]).tobytes():
         raise RuntimeError(f"{entry['name']}: the sample's impulses differ from the whole solve's")
     error = collide.impulse_error(J_sample, ref)
     drift = collide.conservation_drift(sample_bodies, ref)
