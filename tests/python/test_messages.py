@@ -41,6 +41,7 @@ def test_passes_above_the_tools_limit_get_the_tools_message(cli, tmp_path):
     collide.save(str(tmp_path / "b.npz"), str(tmp_path / "c.npz"), bodies, contacts)
     for value in (0, 1_000_001, 10**9):
         r = subprocess.run([cli, "solve", "--bodies", str(tmp_path / "b.npz"), "--contacts", str(tmp_path / "c.npz"),
+                            "--out-bodies", str(tmp_path / "out-b.npz"), "--out-impulses", str(tmp_path / "out-j.npz"),
                             "--passes", str(value)], capture_output=True, text=True)
         assert r.returncode == 2
         tool = r.stderr.splitlines()[0]
