@@ -5,7 +5,7 @@
 //
 // Design notes
 // ------------
-// * The input is cut into windows of Schedule::kColourWindow contacts. In each
+// * The input is cut into windows of kColourWindow contacts. In each
 //   window, contact k takes the lowest colour of kColours that no earlier
 //   contact of the window on one of its movable bodies holds; a contact that
 //   finds none goes to the window's overflow. Immovable bodies join no
@@ -38,16 +38,15 @@
 #include <vector>
 
 #include "batch_sort.hpp"
-#include "collide/schedule.hpp"
+#include "collide/schedule_windows.hpp"
 #include "schedule_input.hpp"
 #include "scratch_vector.hpp"
 
 namespace collide::detail {
 
 /// Colours a window may use; a contact that finds none of them free goes to
-/// the window's overflow.
-inline constexpr std::uint32_t kColours = 24;
-static_assert(kColours == Schedule::kMaxColours);
+/// the window's overflow (Schedule::kMaxColours).
+inline constexpr std::uint32_t kColours = schedule_windows::kMaxColours;
 
 /// What the colour pass keeps between builds.
 struct ColourScratch {

@@ -1,5 +1,5 @@
 // isa_calibration.hpp - which instruction set's kernel runs fastest on this
-// CPU, measured (collide::fastest_isa in collide/solve.hpp).
+// CPU, measured (collide::fastest_isa in collide/isa.hpp).
 //
 // Design notes
 // ------------
@@ -39,9 +39,9 @@
 // ISA's work.
 #pragma once
 
+#include "collide/accuracy.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
-#include "collide/solve.hpp"
 
 namespace collide::detail {
 

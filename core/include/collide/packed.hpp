@@ -209,4 +209,14 @@ void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView
 template <class T>
 void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to);
 
+/// The body layout a solve runs on (SolverOptions::layout).
+enum class BodyLayout {
+  automatic,  ///< SoA input is packed when its contacts reach bodies at random (see Solver)
+  soa,        ///< the caller's SoA arrays, read and written in place
+  packed,     ///< packed records: the caller's, or SoA input packed into the solver's buffer
+};
+
+/// "auto", "soa" or "packed".
+const char* to_string(BodyLayout layout);
+
 }  // namespace collide
