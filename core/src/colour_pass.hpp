@@ -25,8 +25,8 @@
 //   pass clears them between windows), or that the body is immovable. Like
 //   the level pass, it is bound by those random reads on scattered scenes
 //   and prefetches the words kPrefetchDistance contacts ahead. 24 colours,
-//   as Box2D's graph has: a pile needs 6, a debris scene's window rarely
-//   more than a dozen.
+//   as Box2D's graph has, more than the generated scenes' windows use
+//   (docs/decisions/0031-the-colour-order.md).
 // * Every index is screened (contact_indices.hpp) before the window's
 //   colouring reads a table word through it; a window that fails records
 //   itself, and the first bad contact of the first failing window is named,

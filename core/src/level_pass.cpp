@@ -11,7 +11,8 @@ namespace collide::detail {
 namespace {
 
 /// Contacts checked at a time before their indices are used: 2 KiB of
-/// indices, still in L1 when the pass reads them (1024 measured slower).
+/// indices, still in L1 when the pass reads them (larger blocks measured
+/// slower: docs/decisions/0015-the-schedules-level-pass.md).
 constexpr std::size_t kCheckBlock = 256;
 
 /// Every level window starts a check block.

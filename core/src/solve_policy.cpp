@@ -48,10 +48,11 @@ template IsaPick pick_isa<double>(Path, Accuracy, IsaChoice, const KernelTable*,
 /// A caller who hands the contacts over already grouped by level has every
 /// batch consecutive, but the bodies of a debris scene are still read at
 /// random, and reading them in place from SoA arrays (a line per component
-/// per body) is several times slower than packing them: so consecutive
-/// batches of 1024 contacts or more are sampled at kLocalitySamples evenly
-/// spaced places, and count as scattered when most samples find both bodies
-/// far from those of the contact before. The sample reads a few hundred
+/// per body) is far slower than packing them
+/// (docs/decisions/0005-packed-records-for-scattered-contacts.md): so
+/// consecutive batches of 1024 contacts or more are sampled at
+/// kLocalitySamples evenly spaced places, and count as scattered when most
+/// samples find both bodies far from those of the contact before. The sample reads a few hundred
 /// indices: nothing beside the solve.
 bool prepares_contacts(const Schedule& schedule) {
   if (schedule.ordering() != Order::colour) return false;

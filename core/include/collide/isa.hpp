@@ -97,8 +97,8 @@ std::size_t simd_width(Isa isa);
 /// Measured once per process at the first call for each key (thread-safe;
 /// later calls return the cached answer): every ISA the CPU has runs its
 /// kernel on one thread over a small synthetic scene in cache, round by
-/// round, and the fastest best time wins. That takes a millisecond or two
-/// (isa_measurement() says how long). With one ISA, nothing is measured.
+/// round, and the fastest best time wins: a short pause for the first solve
+/// of a kind (isa_measurement() says how long). With one ISA, nothing is measured.
 /// COLLIDE_ISA does not affect it.
 template <class T>
 Isa fastest_isa(Model model, Accuracy accuracy, bool scattered);

@@ -80,7 +80,7 @@ struct SolveStats {
   IsaChoice isa_choice = IsaChoice::forced;  ///< how `isa` was chosen (collide/isa.hpp)
   /// Time this solve spent measuring the ISAs for fastest_isa() [s]: the
   /// first solve of its kind in the process with isa_choice measured pays
-  /// about a millisecond, every later one 0. Part of the solve's wall time.
+  /// for the measurement, every later one 0. Part of the solve's wall time.
   double isa_calibration_seconds = 0;
   /// Time this solve spent in its allocate phase [s]: growing the solver's
   /// buffers (the records SoA input is packed into, the contacts a colour-
