@@ -15,9 +15,9 @@
 // * Per-chunk counts may take at most one 4-byte count per kContactsPerCount
 //   contacts, which keeps a scene of many small batches (a chain) sequential
 //   and inside the memory budget of schedule.hpp.
-// * One-level scenes stay on the calling thread: waking workers for a pass
-//   of a fraction of a millisecond per million contacts cost more wall time
-//   than it saved on a loaded machine.
+// * One-level scenes stay on the calling thread: their pass is too short for
+//   waking workers to pay on a loaded machine
+//   (docs/decisions/0019-contacts-in-level-order-are-not-sorted.md).
 #pragma once
 
 #include <cstddef>

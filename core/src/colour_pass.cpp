@@ -6,13 +6,12 @@
 #include <bit>
 
 #include "chunks.hpp"
-#include "collide/schedule.hpp"
 #include "contact_indices.hpp"
 
 namespace collide::detail {
 namespace {
 
-constexpr std::size_t kWindow = Schedule::kColourWindow;
+constexpr std::size_t kWindow = schedule_windows::kColourWindow;
 
 /// A body's table word: its tag in the top byte and, below, bit c for each
 /// colour c < kColours that its earlier contacts of the window hold. The

@@ -5,7 +5,7 @@
 //
 // Design notes
 // ------------
-// * The input is cut into windows of Schedule::kColourWindow contacts. In each
+// * The input is cut into windows of kColourWindow contacts. In each
 //   window, contact k takes the lowest colour of kColours that no earlier
 //   contact of the window on one of its movable bodies holds; a contact that
 //   finds none goes to the window's overflow. Immovable bodies join no
@@ -25,8 +25,8 @@
 //   pass clears them between windows), or that the body is immovable. Like
 //   the level pass, it is bound by those random reads on scattered scenes
 //   and prefetches the words kPrefetchDistance contacts ahead. 24 colours,
-//   as Box2D's graph has: a pile needs 6, a debris scene's window rarely
-//   more than a dozen.
+//   as Box2D's graph has, more than the generated scenes' windows use
+//   (docs/decisions/0031-the-colour-order.md).
 // * Every index is screened (contact_indices.hpp) before the window's
 //   colouring reads a table word through it; a window that fails records
 //   itself, and the first bad contact of the first failing window is named,
@@ -38,16 +38,15 @@
 #include <vector>
 
 #include "batch_sort.hpp"
-#include "collide/schedule.hpp"
+#include "collide/schedule_windows.hpp"
 #include "schedule_input.hpp"
 #include "scratch_vector.hpp"
 
 namespace collide::detail {
 
 /// Colours a window may use; a contact that finds none of them free goes to
-/// the window's overflow.
-inline constexpr std::uint32_t kColours = 24;
-static_assert(kColours == Schedule::kMaxColours);
+/// the window's overflow (Schedule::kMaxColours).
+inline constexpr std::uint32_t kColours = schedule_windows::kMaxColours;
 
 /// What the colour pass keeps between builds.
 struct ColourScratch {

@@ -7,7 +7,8 @@
 // ------------
 // The screen is branch-free, so that it vectorises, and compares in 32 bits:
 // SSE2 has no unsigned 32-bit compare, so with GCC on x86-64 it is also
-// compiled for AVX2 and picked at load time (an ifunc), about twice as fast.
+// compiled for AVX2 and picked at load time (an ifunc), which has one (its
+// gain: docs/decisions/0013-python-call-overhead.md).
 // With 2^32 or more bodies its bound is one too strict for index 2^32 - 1,
 // which the exact scan (first_bad_contact) then accepts. The scan runs only
 // when the screen fails, so the message never depends on the screen.

@@ -154,7 +154,7 @@ inline constexpr bool kWideLeverArms =
 ///     R^T x = x + s (q_v x (q_v x x) - q_w (q_v x x)),   s = 2 / |q|^2,
 /// which needs no matrix: computed from the float lanes at each use, it keeps
 /// no double-lane state alive across the kernel (a double-lane matrix per body
-/// cost 0.6x in throughput through register spills). In double lanes c - p
+/// spilled registers: docs/decisions/0009-the-fast-modes-lever-arms.md). In double lanes c - p
 /// and every product of two floats are exact and every other rounding is
 /// 2^-53, so h is the exact law's h rounded once to float
 /// (docs/collision-law.md, "The lever arms").
@@ -625,13 +625,13 @@ COLLIDE_LANE_INLINE Vec3<V> summed_impulse(const Vec3<V>& before, const Vec3<V>&
 /// evaluate_law_accurately, not inlined, for double: its double-double lanes
 /// make that body several times the fast mode's, and inlined into every
 /// caller (each model with and without friction, on each layout and body
-/// stream) it was half of each kernel object's compile time. Each caller
-/// calls the one copy of its model and friction instead; against the
-/// hundreds of double-double operations of a group, the call and the lanes
-/// passed through memory cost a few percent. The float kernel's wider lanes
-/// are plain double, cheap enough that the call would cost it more than
-/// its share of the compile time
-/// (docs/decisions/0032-the-double-accurate-law-out-of-line.md).
+/// stream) it made the largest functions of each kernel object's compile.
+/// Each caller calls the one copy of its model and friction instead; against
+/// the hundreds of double-double operations of a group, the call and the
+/// lanes passed through memory cost little. The float kernel's wider lanes
+/// are plain double, cheap enough that the call would show in its speed;
+/// the compile times and the cost of the call:
+/// docs/decisions/0032-the-double-accurate-law-out-of-line.md.
 template <class M, class V, bool kFriction>
 __attribute__((noinline)) ContactResult<V> evaluate_law_accurately_out_of_line(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
                                                                                const ContactLanes<V>& contact) {

@@ -9,9 +9,9 @@
 //   (collide/large_allocator.hpp). A one-shot solve (`collide solve`, a
 //   Python collide.solve, a Dask task) grows every buffer of a fresh Solver;
 //   left to the passes that first write them, those faults fell inside the
-//   kernel's time, and made it vary from run to run (a 3M-contact pile in the
-//   colour order: 40,000 more faults than in the input order, and kernel
-//   times from 90 to 277 ms).
+//   kernel's time, and made it vary from run to run (most in the colour
+//   order, whose copy of the contacts is fresh memory too; the measurements:
+//   docs/decisions/0023-fresh-arrays-touched-where-they-are-written.md).
 // * What: a Solver first sizes every buffer the solve will use, collecting
 //   the bytes that are new in a FirstTouch, and has them touched, one byte
 //   per 4 KiB page, by the threads of its arena: the allocate phase,

@@ -33,8 +33,8 @@ constexpr std::size_t kContacts = 1024;
 constexpr std::size_t kWarmUpContacts = 256;
 /// A timed pass runs as many contacts (a multiple of kGroup, at most
 /// kContacts) as the slowest ISA resolves in about this time: the slow
-/// kernels (double, accurate mode: up to ~0.6 us per contact on SSE2) would
-/// otherwise take several milliseconds per key.
+/// kernels (double, accurate mode, on SSE2) would otherwise make a key cost
+/// many times the fast ones' (docs/decisions/0006 has their costs).
 constexpr double kPassSeconds = 100e-6;
 constexpr std::size_t kGroup = 64;
 /// Timed rounds, after one warm-up round.

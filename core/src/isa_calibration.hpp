@@ -1,5 +1,5 @@
 // isa_calibration.hpp - which instruction set's kernel runs fastest on this
-// CPU, measured (collide::fastest_isa in collide/solve.hpp).
+// CPU, measured (collide::fastest_isa in collide/isa.hpp).
 //
 // Design notes
 // ------------
@@ -30,8 +30,8 @@
 // ms, so that the slow kernels (double in the accurate mode) cost no more
 // than the fast ones. The ISAs alternate within each of 5 timed rounds, the
 // first rotating from round to round; each ISA keeps its best pass, and the
-// lowest wins. A key costs a millisecond or two, paid by the first solve of
-// its kind (SolveStats::isa_calibration_seconds).
+// lowest wins. What a key costs is paid by the first solve of its kind
+// (SolveStats::isa_calibration_seconds; docs/decisions/0006 has the cost).
 //
 // In cache the kernel's own cost decides, which is where the ISAs differ;
 // where memory bounds a large solve, every ISA waits on the same lines.
@@ -39,9 +39,9 @@
 // ISA's work.
 #pragma once
 
+#include "collide/accuracy.hpp"
 #include "collide/isa.hpp"
 #include "collide/model.hpp"
-#include "collide/solve.hpp"
 
 namespace collide::detail {
 

@@ -14,16 +14,16 @@
 // block of ~1024 contacts (and one for its tail) is then the whole cost of
 // dispatch.
 //
-// Why one function per choice, and several objects per ISA: when one object
-// held every loop of an ISA, all inlined into a few entry points, it took
-// 140-250 s to compile, and a change to one loop moved the others' code and
-// with it their speed, by up to 1.39x on an unchanged loop
+// Why one function per choice, and several objects per ISA: one object that
+// held every loop of an ISA, all inlined into a few entry points, was the
+// longest compile of a build (decision 0032 has the times), and a change to
+// one loop moved the others' code and with it their speed
 // (docs/decisions/0036-the-avx512-gather-instruction-measured.md). Now the
 // loops of one model, precision and accuracy mode are an object of their own
-// (kernel/units.hpp: kernel/rigid_float_fast.cpp, ...), each compiled in
-// under a minute, and every function and loop of a kernel object starts on a
-// 64-byte boundary (cmake/flags.cmake), so a loop's placement does not depend
-// on what precedes it.
+// (kernel/units.hpp: kernel/rigid_float_fast.cpp, ...), a short compile each,
+// and every function and loop of a kernel object starts on a 64-byte
+// boundary (cmake/flags.cmake), so a loop's placement does not depend on
+// what precedes it.
 //
 // The per-ISA objects contain nothing but the kernel templates, in an inline
 // namespace named for their ISA (lanes.hpp) and an anonymous one, and their

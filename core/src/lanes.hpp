@@ -17,9 +17,9 @@
 // measures the three; docs/decisions/0003-the-lane-layer.md has the figures).
 //
 // AVX2 has gathers but no scatters, and its vgatherdps is slower on AMD
-// cores than W scalar loads and inserts (the pairs scene lost a fifth with
-// it), so gather() is a generator constructor (W scalar loads) and
-// scatter() W scalar stores.
+// cores than W scalar loads and inserts (docs/decisions/0003-the-lane-layer.md
+// has the measurement), so gather() is a generator constructor (W scalar
+// loads) and scatter() W scalar stores.
 //
 // Floating point: every operation here is an IEEE add, sub, mul, div, sqrt,
 // min or compare, each correctly rounded; with -ffp-contract=off nothing is
@@ -48,12 +48,12 @@
 
 // Everything a kernel body calls is forced inline: GCC's heuristics give up
 // on functions that take several 8-lane structs, and an out-of-line call
-// passes them through memory: gather_bodies (kernel/loops.hpp) out of line
-// costs a third of the kernel's time. The exceptions are measured:
-// load_streams_out_of_line (kernel/loops.hpp), where three kinds of loads
-// met inside the law and made it spill, and the double accurate law
-// (contact_kernel.hpp). The loops themselves are functions of their own,
-// one per choice of the kernel table (kernel_table.hpp), never inlined.
+// passes them through memory, which the kernel pays for on every group
+// (gather_bodies out of line: docs/decisions/0003-the-lane-layer.md). Two
+// exceptions, each measured: load_streams_out_of_line (kernel/loops.hpp),
+// where three kinds of loads met inside the law and made it spill (decision
+// 0035), and the double accurate law (contact_kernel.hpp, decision 0032). The
+// loops are functions of their own, one per choice of the table, never inlined.
 #define COLLIDE_LANE_INLINE inline __attribute__((always_inline))
 // The same for the lambdas a kernel passes to its field visitors.
 #define COLLIDE_LANE_LAMBDA __attribute__((always_inline))

@@ -4,18 +4,19 @@
 #include <algorithm>
 #include <utility>
 
-#include "collide/schedule.hpp"
+#include "collide/schedule_windows.hpp"
 #include "contact_indices.hpp"
 
 namespace collide::detail {
 namespace {
 
 /// Contacts checked at a time before their indices are used: 2 KiB of
-/// indices, still in L1 when the pass reads them (1024 measured slower).
+/// indices, still in L1 when the pass reads them (larger blocks measured
+/// slower: docs/decisions/0015-the-schedules-level-pass.md).
 constexpr std::size_t kCheckBlock = 256;
 
 /// Every level window starts a check block.
-static_assert(Schedule::kLevelWindow % kCheckBlock == 0);
+static_assert(schedule_windows::kLevelWindow % kCheckBlock == 0);
 
 inline void prefetch_for_write(const void* p) {
 #if defined(__GNUC__)
@@ -84,9 +85,9 @@ std::size_t assign_levels(const ContactIndices& contacts, std::size_t from, Word
     // Blocks start at multiples of kCheckBlock, also after a narrow pass
     // stopped mid-block, so that every window boundary starts a block.
     const std::size_t end = std::min(n, (k / kCheckBlock + 1) * kCheckBlock);
-    if (k % Schedule::kLevelWindow == 0 && k > 0) {
-      const auto [lowest, highest] = level_span(level, k - Schedule::kLevelWindow, k);
-      if (highest - lowest < Schedule::kShallowWindowLevels) floor = static_cast<Word>(levels - 1);
+    if (k % schedule_windows::kLevelWindow == 0 && k > 0) {
+      const auto [lowest, highest] = level_span(level, k - schedule_windows::kLevelWindow, k);
+      if (highest - lowest < schedule_windows::kShallowWindowLevels) floor = static_cast<Word>(levels - 1);
     }
     check_contact_indices("collide::Schedule::build: ", a, b, k, end, contacts.body_count);
     // The next block's indices: its check reads them in a burst, which on

@@ -22,8 +22,8 @@
 // * Every index is checked before it is used (contact_indices.hpp): each
 //   block of kCheckBlock contacts is screened branch-free, then assigned, so
 //   a contact that fails throws before any table word of it is read or
-//   written; a branch per contact inside the loop costs about twice as much
-//   as the blocks.
+//   written; a branch per contact inside the loop costs more than the
+//   blocks.
 // * The table and the levels are bytes while the levels fit below the
 //   sentinel (fewer than 254 levels: every scene but long chains): a table of
 //   1M bodies then fits in L2, and the pass streams a quarter of the bytes.

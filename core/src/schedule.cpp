@@ -134,7 +134,7 @@ void Schedule::clear() {
   overflow_contacts_ = 0;
   // order keeps its size: every entry is rewritten by a build that
   // succeeds, and clearing it made the resize write the whole array once
-  // more (a fifth of the build of a scene of pairs).
+  // more (its cost: docs/decisions/0023-fresh-arrays-touched-where-they-are-written.md).
   impl_->batches.begin.clear();
   impl_->batches.contiguous.clear();
   impl_->batches.largest = 0;

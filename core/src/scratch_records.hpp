@@ -2,12 +2,13 @@
 // packed records, grown to the largest scene and kept.
 //
 // A std::vector would zero every record it grows by, and the first touch of
-// each 4 KiB page is a page fault: packing 2M rigid bodies (256 MiB) into a
-// fresh vector spent more time in memset and faults than in the kernel
-// (perf, `collide solve` on 2M debris). So the storage is left
-// uninitialised (pack() writes every record before the kernel reads it) and
-// in huge pages (collide/large_allocator.hpp): 2 MiB pages fault 512 times less
-// often and cost fewer TLB misses on random access. New storage is first
+// each 4 KiB page is a page fault: on a scene of millions of bodies the two
+// outweighed the kernel itself (the profile:
+// docs/decisions/0023-fresh-arrays-touched-where-they-are-written.md). So
+// the storage is left uninitialised (pack() writes every record before the
+// kernel reads it) and in huge pages (collide/large_allocator.hpp): 2 MiB
+// pages fault 512 times less often and cost fewer TLB misses on random
+// access. New storage is first
 // touched by the solver's allocate phase (first_touch.hpp), on every thread,
 // before packing starts.
 #pragma once

@@ -35,8 +35,8 @@
 
 #include <oneapi/tbb/task_arena.h>
 
+#include "collide/external_arena.hpp"
 #include "collide/solve.hpp"
-#include "collide/tbb.hpp"
 #include "collide/validate.hpp"
 #include "first_touch.hpp"
 #include "kernel_table.hpp"
@@ -350,8 +350,8 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   detail::check_solve_input(impl_->options, model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   const std::size_t scattered = detail::scattered_contacts(schedule, contacts.a, contacts.b);
-  const detail::IsaPick pick = detail::pick_isa<T>(impl_->options, impl_->isa_choice, impl_->kernels, model, scattered,
-                                                   schedule.contact_count());
+  const detail::IsaPick pick = detail::pick_isa<T>(impl_->options.path, impl_->options.accuracy, impl_->isa_choice,
+                                                   impl_->kernels, model, scattered, schedule.contact_count());
   if (!detail::should_pack(impl_->options.layout, scattered, bodies.count)) {
     detail::set_view(job, bodies);
     return impl_->run(pick, job, schedule, 0.0);
@@ -386,7 +386,7 @@ SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, c
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   detail::set_view(job, bodies);
   const detail::IsaPick pick =
-      detail::pick_isa<T>(impl_->options, impl_->isa_choice, impl_->kernels, model,
+      detail::pick_isa<T>(impl_->options.path, impl_->options.accuracy, impl_->isa_choice, impl_->kernels, model,
                           detail::scattered_contacts(schedule, contacts.a, contacts.b), schedule.contact_count());
   // The caller's records are solved in place: no packing buffer of the
   // solver's is used, so solves on one Solver may run at once, as on SoA

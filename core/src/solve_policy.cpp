@@ -33,25 +33,26 @@ const KernelTable* fixed_kernels(Isa requested, IsaChoice choice) {
 }
 
 template <class T>
-IsaPick pick_isa(const SolverOptions& options, IsaChoice choice, const KernelTable* fixed, Model model,
+IsaPick pick_isa(Path path, Accuracy accuracy, IsaChoice choice, const KernelTable* fixed, Model model,
                  std::size_t scattered, std::size_t contacts) {
-  if (options.path == Path::scalar) return {&kernel_table(Isa::sse2), IsaChoice::baseline, 0.0};
+  if (path == Path::scalar) return {&kernel_table(Isa::sse2), IsaChoice::baseline, 0.0};
   if (fixed != nullptr) return {fixed, choice, 0.0};
   double spent = 0;
-  const Isa isa = measured_isa<T>(model, options.accuracy, 2 * scattered > contacts, &spent).fastest;
+  const Isa isa = measured_isa<T>(model, accuracy, 2 * scattered > contacts, &spent).fastest;
   return {&kernel_table(isa), IsaChoice::measured, spent};
 }
 
-template IsaPick pick_isa<float>(const SolverOptions&, IsaChoice, const KernelTable*, Model, std::size_t, std::size_t);
-template IsaPick pick_isa<double>(const SolverOptions&, IsaChoice, const KernelTable*, Model, std::size_t, std::size_t);
+template IsaPick pick_isa<float>(Path, Accuracy, IsaChoice, const KernelTable*, Model, std::size_t, std::size_t);
+template IsaPick pick_isa<double>(Path, Accuracy, IsaChoice, const KernelTable*, Model, std::size_t, std::size_t);
 
 /// A caller who hands the contacts over already grouped by level has every
 /// batch consecutive, but the bodies of a debris scene are still read at
 /// random, and reading them in place from SoA arrays (a line per component
-/// per body) is several times slower than packing them: so consecutive
-/// batches of 1024 contacts or more are sampled at kLocalitySamples evenly
-/// spaced places, and count as scattered when most samples find both bodies
-/// far from those of the contact before. The sample reads a few hundred
+/// per body) is far slower than packing them
+/// (docs/decisions/0005-packed-records-for-scattered-contacts.md): so
+/// consecutive batches of 1024 contacts or more are sampled at
+/// kLocalitySamples evenly spaced places, and count as scattered when most
+/// samples find both bodies far from those of the contact before. The sample reads a few hundred
 /// indices: nothing beside the solve.
 bool prepares_contacts(const Schedule& schedule) {
   if (schedule.ordering() != Order::colour) return false;

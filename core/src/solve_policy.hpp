@@ -6,8 +6,12 @@
 
 #include <cstddef>
 
+#include "collide/accuracy.hpp"
+#include "collide/bodies.hpp"
+#include "collide/isa.hpp"
+#include "collide/model.hpp"
+#include "collide/packed.hpp"
 #include "collide/schedule.hpp"
-#include "collide/solve.hpp"
 #include "kernel_table.hpp"
 
 namespace collide::detail {
@@ -29,12 +33,13 @@ struct IsaPick {
   double calibration_seconds;  ///< spent measuring by this solve (SolveStats::isa_calibration_seconds)
 };
 
-/// The ISA of a solve of `model` in T: the fixed one, or the fastest for the
-/// solve's kind (measured on first use; scattered when most of its contacts
-/// are, scattered_contacts). The scalar path runs the baseline's one-lane
-/// kernel whatever the choice, and measures nothing.
+/// The ISA of a solve of `model` in T on `path` in `accuracy` (the
+/// SolverOptions'): the fixed one, or the fastest for the solve's kind
+/// (measured on first use; scattered when most of its contacts are,
+/// scattered_contacts). The scalar path runs the baseline's one-lane kernel
+/// whatever the choice, and measures nothing.
 template <class T>
-IsaPick pick_isa(const SolverOptions& options, IsaChoice choice, const KernelTable* fixed, Model model,
+IsaPick pick_isa(Path path, Accuracy accuracy, IsaChoice choice, const KernelTable* fixed, Model model,
                  std::size_t scattered, std::size_t contacts);
 
 /// Contacts of the schedule that reach their bodies at random: those of

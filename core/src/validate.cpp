@@ -6,21 +6,22 @@
 // the one whose cost every Python call pays) is cheap:
 //  * the screen: branch-free passes that only answer "all good", written on
 //    the lane layer's lanes (lanes.hpp; 4 float or 2 double lanes in the
-//    SSE2 baseline this file is built for; about 5x faster than the scan at
-//    1k contacts), and run in parallel chunks on large scenes, where one
-//    core's memory bandwidth is the limit. Each screen is as strict as the
-//    scan's rule or stricter (the unit-norm screen uses a band inside the
-//    scan's tolerance; -0.0 fails the sign screen), so when every screen
-//    passes the scan would find nothing. A screen ORs the bits of its
-//    values into integer lanes (a bit cast of the lanes) across iterations
-//    and tests them once at the end, with no compare in the loop and no
-//    floating-point value carried from one iteration to the next. Compare
-//    masks OR-ed the same way give the same verdicts but cost more on SSE2
-//    with GCC 12's std::experimental::simd: a double mask is OR-ed lane by
-//    lane through general registers, and signbit of a double is a 64-bit
-//    integer compare that SSE2 lacks; validate() on 1k contacts ran 62-65%
-//    more instructions in double and 17% more in float (callgrind), where
-//    the bit form runs the instructions of hand-written vectors;
+//    SSE2 baseline this file is built for; their cost against the scan's:
+//    docs/decisions/0013-python-call-overhead.md), and run in parallel
+//    chunks on large scenes, where one core's memory bandwidth is the
+//    limit. Each screen is as strict as the scan's rule or stricter (the
+//    unit-norm screen uses a band inside the scan's tolerance; -0.0 fails
+//    the sign screen), so when every screen passes the scan would find
+//    nothing. A screen ORs the bits of its values into integer lanes (a bit
+//    cast of the lanes) across iterations and tests them once at the end,
+//    with no compare in the loop and no floating-point value carried from
+//    one iteration to the next. Compare masks OR-ed the same way give the
+//    same verdicts but cost more on SSE2 with GCC 12's
+//    std::experimental::simd: a double mask is OR-ed lane by lane through
+//    general registers, and signbit of a double is a 64-bit integer compare
+//    that SSE2 lacks, so validate() ran more instructions, most in double
+//    (decision 0013 has the counts), where the bit form runs the
+//    instructions of hand-written vectors;
 //  * the scan: element by element in a fixed order, stopping at the first
 //    problem so the message names one element. It runs only when a screen
 //    fails, so the message does not depend on the screens.

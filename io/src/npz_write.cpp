@@ -282,8 +282,9 @@ void write_npz(OutputFile& out, const std::vector<NpzColumn>& columns) {
   }
   // A file under a temporary name: every piece goes to its offset, the
   // large ones in slices on every thread. Writing new page-cache pages is
-  // bound by allocating and filling them, which one thread did at 0.4 GB/s
-  // on a VM that hands free memory back to its host.
+  // bound by allocating and filling them, which one thread does slowly on a
+  // VM that hands free memory back to its host
+  // (docs/decisions/0027-writing-the-binary-scene-files.md).
   constexpr std::size_t kSlice = std::size_t{8} << 20;
   struct Piece {
     std::uint64_t offset;

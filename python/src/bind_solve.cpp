@@ -220,9 +220,9 @@ struct PySolver {
     }
     const auto asked = static_cast<std::size_t>(solver->options().passes);
     if (stats.passes < asked) raise_interrupted(stats.passes, asked);
-    // impacts=False: no pass over J (at a million contacts it costs 5-10% of
-    // a particle solve); the record is built over no impulses and the key
-    // set to None.
+    // impacts=False: no pass over J (its cost beside a particle solve's:
+    // docs/decisions/0013-python-call-overhead.md); the record is built over
+    // no impulses and the key set to None.
     const ImpulseView<const T> jc{impacts ? jv.count : 0, {jv.j.x, jv.j.y, jv.j.z}};
     py::dict d =
         to_dict(solve_record<T>(stats, jc, bodies.count, kernel_seconds, schedule == &own ? own.build_seconds : 0.0));

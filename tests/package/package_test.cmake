@@ -157,8 +157,8 @@ elseif(MODE STREQUAL "add_subdirectory")
   # embedding project may choose): this test is about the packaging, the
   # per-ISA kernels are tested in the main build, and each one more would
   # cost minutes of CI time. (It stays a Release build: unoptimised, the
-  # kernel's forced inlining and its debug information took longer still,
-  # 764 s against 293 s for the sse2 kernel object.)
+  # kernel's forced inlining and its debug information take longer still to
+  # compile: docs/decisions/0032-the-double-accurate-law-out-of-line.md.)
   #
   # The embedded tree is a copy of the checkout's files with collide's binary
   # directory one level under it, as build/ is under the checkout, and the

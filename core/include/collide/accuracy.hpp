@@ -1,4 +1,5 @@
-// collide/accuracy.hpp - what the kernels promise about their error.
+// collide/accuracy.hpp - the two accuracy modes of the kernels, and what each
+// promises about its error.
 //
 // Two modes, two promises (docs/collision-law.md, "Error bounds"):
 //
@@ -14,7 +15,23 @@
 // bound (collide/model.hpp).
 #pragma once
 
+#include <string_view>
+
 namespace collide {
+
+/// How the law's cancellation-prone quantities are evaluated. Both modes
+/// compute the same law on the same paths, ISAs and thread counts, and each
+/// is bitwise identical across them; they differ from each other in the last
+/// bits (docs/collision-law.md, "Accuracy modes").
+enum class Accuracy {
+  fast,      ///< plain IEEE arithmetic in the working precision
+  accurate,  ///< the relative velocity, the lever arms and friction's u' free of cancellation
+};
+
+/// "fast" or "accurate".
+const char* to_string(Accuracy accuracy);
+/// Parses the names of to_string(); throws std::invalid_argument otherwise.
+Accuracy parse_accuracy(std::string_view name);
 
 /// The documented bound on a fast-mode impulse error, in units of
 /// eps(T) * impulse_scale (plus an underflow floor; collide/eval/error_bound.hpp).

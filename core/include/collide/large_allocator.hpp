@@ -3,10 +3,10 @@
 // contacts.hpp, the labels of labels.hpp, the solver's scratch, the columns
 // of a scene file read into memory and the triad's arrays.
 //
-// Why: the first touch of a page is a fault, and a fault costs about as much
-// as moving the page's bytes several times over (in a virtual machine more
-// still: 753 MiB first touched in 4 KiB pages took 3.0 s, in 2 MiB pages
-// 0.3-1.5 s). Arrays of millions of contacts or bodies are touched once right
+// Why: the first touch of a page is a fault, and a fault costs more than
+// moving the page's bytes (in a virtual machine, whose host serves the fault
+// too, more still: docs/decisions/0034-large-arrays-in-huge-pages.md has the
+// measurements). Arrays of millions of contacts or bodies are touched once right
 // after they are allocated, so their faults are a large part of that pass.
 // Transparent huge pages in "madvise" mode (Debian's default) give 2 MiB
 // pages only to memory advised so; the advice is harmless where they are off.

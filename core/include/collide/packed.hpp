@@ -8,9 +8,9 @@
 // order (the pairs scene), but a contact that reaches a random body touches
 // one cache line per component: 17 lines read and 6 written for a rigid
 // body, and the kernel then waits on memory latency, not bandwidth (debris
-// ran at a twentieth of pairs). A packed record holds the body's state in
-// one or two adjacent cache lines, so a random body costs one or two misses,
-// which the solver prefetches a few groups ahead.
+// ran far below pairs: decision 0005, named below). A packed record holds
+// the body's state in one or two adjacent cache lines, so a random body
+// costs one or two misses, which the solver prefetches a few groups ahead.
 //
 // Each record is aligned to its size (a cache line, or a fraction of one that
 // divides it), so no record straddles more lines than it must:
@@ -208,5 +208,15 @@ template <class T>
 void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to);
 template <class T>
 void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to);
+
+/// The body layout a solve runs on (SolverOptions::layout).
+enum class BodyLayout {
+  automatic,  ///< SoA input is packed when its contacts reach bodies at random (see Solver)
+  soa,        ///< the caller's SoA arrays, read and written in place
+  packed,     ///< packed records: the caller's, or SoA input packed into the solver's buffer
+};
+
+/// "auto", "soa" or "packed".
+const char* to_string(BodyLayout layout);
 
 }  // namespace collide

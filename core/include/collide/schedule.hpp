@@ -75,6 +75,7 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/packed.hpp"
+#include "collide/schedule_windows.hpp"
 
 namespace collide {
 
@@ -93,13 +94,13 @@ Order parse_order(std::string_view name);
 class Schedule {
  public:
   /// Contacts per level window of the input order (design notes above).
-  static constexpr std::size_t kLevelWindow = std::size_t{1} << 16;
+  static constexpr std::size_t kLevelWindow = schedule_windows::kLevelWindow;
   /// A window whose levels span fewer than this raises the floor of the next.
-  static constexpr std::uint32_t kShallowWindowLevels = 16;
+  static constexpr std::uint32_t kShallowWindowLevels = schedule_windows::kShallowWindowLevels;
   /// Contacts per window of the colour order.
-  static constexpr std::size_t kColourWindow = std::size_t{1} << 16;
+  static constexpr std::size_t kColourWindow = schedule_windows::kColourWindow;
   /// Colours a window of the colour order may use before its overflow.
-  static constexpr std::uint32_t kMaxColours = 24;
+  static constexpr std::uint32_t kMaxColours = schedule_windows::kMaxColours;
 
   /// An empty schedule that build() fills in `order`.
   explicit Schedule(Order order = Order::input);

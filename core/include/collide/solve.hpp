@@ -20,38 +20,11 @@
 #include "collide/schedule.hpp"
 
 namespace collide {
-/// Which implementation of the kernel runs.
-enum class Path {
-  scalar,  ///< one contact at a time (lane width 1)
-  simd,    ///< SIMD lanes: 16 float / 8 double with AVX-512, 8 / 4 with AVX2, 4 / 2 with SSE2
-};
 
-const char* to_string(Path path);
-
-/// The body layout a solve runs on (collide/packed.hpp).
-enum class BodyLayout {
-  automatic,  ///< SoA input is packed when its contacts reach bodies at random (see Solver)
-  soa,        ///< the caller's SoA arrays, read and written in place
-  packed,     ///< packed records: the caller's, or SoA input packed into the solver's buffer
-};
-
-/// "auto", "soa" or "packed".
-const char* to_string(BodyLayout layout);
-
-/// How the law's cancellation-prone quantities are evaluated. Both modes
-/// compute the same law on the same paths, ISAs and thread counts, and each
-/// is bitwise identical across them; they differ from each other in the last
-/// bits (docs/collision-law.md, "Accuracy modes").
-enum class Accuracy {
-  fast,      ///< plain IEEE arithmetic in the working precision
-  accurate,  ///< the relative velocity, the lever arms and friction's u' free of cancellation
-};
-
-/// "fast" or "accurate".
-const char* to_string(Accuracy accuracy);
-/// Parses the names of to_string(); throws std::invalid_argument otherwise.
-Accuracy parse_accuracy(std::string_view name);
-
+/// How a Solver runs. The kinds of its choices stand beside what they choose
+/// between: Path and Isa in collide/isa.hpp, Accuracy in
+/// collide/accuracy.hpp, BodyLayout in collide/packed.hpp and Order in
+/// collide/schedule.hpp.
 struct SolverOptions {
   Path path = Path::simd;
   /// Worker threads; 0 means every hardware thread. Results do not depend on
@@ -117,7 +90,7 @@ struct SolveStats {
   IsaChoice isa_choice = IsaChoice::forced;  ///< how `isa` was chosen (collide/isa.hpp)
   /// Time this solve spent measuring the ISAs for fastest_isa() [s]: the
   /// first solve of its kind in the process with isa_choice measured pays
-  /// about a millisecond, every later one 0. Part of the solve's wall time.
+  /// for the measurement, every later one 0. Part of the solve's wall time.
   double isa_calibration_seconds = 0;
   /// Time this solve spent in its allocate phase [s]: growing the solver's
   /// buffers (the records SoA input is packed into, the contacts a colour-
@@ -144,45 +117,11 @@ struct SolveStats {
 template <class T>
 std::size_t simd_width();
 
-/// The ISA whose SIMD kernel ran fastest on this CPU for `model` in precision
-/// T (float or double) and `accuracy`, on a streaming scene (scattered =
-/// false: contact k joins bodies 2k and 2k+1, the SoA arrays in order) or a
-/// scattered one (scattered = true: contacts reach packed bodies at random,
-/// as in the debris scene). It is what a Solver with Isa::automatic and
-/// COLLIDE_ISA unset runs; a solve counts as scattered when most of its
-/// schedule's contacts reach their bodies at random: those in non-contiguous
-/// batches, and those of consecutive batches whose bodies, sampled, do not
-/// follow one another (contacts handed over grouped by level).
-///
-/// Measured once per process at the first call for each key (thread-safe;
-/// later calls return the cached answer): every ISA the CPU has runs its
-/// kernel on one thread over a small synthetic scene in cache, round by
-/// round, and the fastest best time wins. That takes a millisecond or two
-/// (isa_measurement() says how long). With one ISA, nothing is measured.
-/// COLLIDE_ISA does not affect it.
-template <class T>
-Isa fastest_isa(Model model, Accuracy accuracy, bool scattered);
+// fastest_isa() and isa_measurement(), the ISA a solve with Isa::automatic
+// runs and the measurement behind it: collide/isa.hpp.
 
-/// What the measurement behind fastest_isa() found for one key.
-struct IsaMeasurement {
-  Isa fastest = Isa::sse2;  ///< fastest_isa() for the key
-  /// Contacts of each timed pass over the synthetic scene: up to 1024, fewer
-  /// for slow kernels (0: nothing was measured).
-  std::size_t contacts = 0;
-  int rounds = 0;                  ///< timed passes per ISA (after one warm-up pass)
-  double calibration_seconds = 0;  ///< wall time of the whole measurement [s]
-  /// The best time of one timed pass for sse2, avx2 and avx512 in that order
-  /// [s]; 0 for an ISA not measured (the CPU lacks it).
-  double seconds[3] = {0, 0, 0};
-};
-
-/// The measurement of fastest_isa(model, accuracy, scattered), run first if
-/// it has not run in this process yet.
-template <class T>
-IsaMeasurement isa_measurement(Model model, Accuracy accuracy, bool scattered);
-
-/// A caller's tbb::task_arena, defined in collide/tbb.hpp so that this header
-/// does not need TBB.
+/// A caller's tbb::task_arena, defined in collide/external_arena.hpp so that
+/// this header does not need TBB.
 struct ExternalArena;
 
 /// A reusable solver. It owns the worker threads (a tbb::task_arena), or runs

@@ -10,19 +10,13 @@
 
 #include <oneapi/tbb/task_arena.h>
 
+#include "collide/external_arena.hpp"
 #include "collide/solve.hpp"
 
 namespace collide {
 
-/// A caller's arena, borrowed by a Solver (see Solver(const ExternalArena&, ...)).
-struct ExternalArena {
-  tbb::task_arena& arena;
-};
-
 /// A solver that runs in `arena`, which must outlive it. options.threads must
 /// be 0: the arena decides the concurrency. Results do not depend on it.
-inline Solver make_solver(tbb::task_arena& arena, const SolverOptions& options = {}) {
-  return Solver(ExternalArena{arena}, options);
-}
+Solver make_solver(tbb::task_arena& arena, const SolverOptions& options = {});
 
 }  // namespace collide

@@ -1,9 +1,9 @@
 // kernel/units.hpp - the kernel units of one instruction set, as its table
 // (kernel/table.cpp) calls them: one unit per body model, precision and
 // accuracy mode (kernel/<model>_<precision>_<mode>.cpp), each filling its
-// slots of the table (kernel/loops.hpp, add_unit_loops). Units of that size
-// each compile in under a minute, where a model's every loop in one unit
-// took up to 100 s on AVX-512.
+// slots of the table (kernel/loops.hpp, add_unit_loops): units of that size
+// compile in a fraction of the time a unit of a model's every loop took
+// (docs/decisions/0032-the-double-accurate-law-out-of-line.md has the times).
 #pragma once
 
 #include "kernel_table.hpp"

@@ -116,7 +116,7 @@ struct IsaAutoPick {
   bool scattered = false;          ///< a scattered scene (debris-like), else streaming (pairs-like)
   std::string isa;                 ///< the pick
   double calibration_seconds = 0;  ///< time the measurement took
-  /// Best pass of each ISA measured, in ns per contact, named ("sse2": 21.5).
+  /// Best pass of each ISA measured, in ns per contact, named by the ISA ("sse2", ...).
   std::vector<std::pair<std::string, double>> ns_per_contact;
 };
 

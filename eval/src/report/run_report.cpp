@@ -38,9 +38,10 @@
 // * Budget (the default run is README command 1 and must take a few
 //   minutes on a 2-core machine): the pairs scene has --n collisions (1M by
 //   default); the debris scene min(--n, 1M) unless --debris-n says otherwise,
-//   because its random body accesses make it 3 to 10 times slower per
-//   collision (latency-bound gathers): 48 kernel rows of five runs of 4M
-//   debris collisions take minutes. The pile scene likewise has at most
+//   because its random body accesses make it several times slower per
+//   collision (latency-bound gathers), and its kernel rows at 4M debris
+//   collisions alone would take minutes
+//   (docs/decisions/0014-the-reports-default-run.md). The pile scene likewise has at most
 //   min(--n, 1M) contacts unless --pile-n says otherwise (the largest cubic
 //   pile within it: 69^3 boxes, 976005 contacts); its contacts reach nearby
 //   bodies in cell order, but share them in chains some 9 x side batches
