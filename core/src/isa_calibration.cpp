@@ -34,7 +34,7 @@ constexpr std::size_t kWarmUpContacts = 256;
 /// A timed pass runs as many contacts (a multiple of kGroup, at most
 /// kContacts) as the slowest ISA resolves in about this time: the slow
 /// kernels (double, accurate mode, on SSE2) would otherwise make a key cost
-/// many times the fast ones' (docs/decisions/0006 has their costs).
+/// many times the fast ones' (docs/decisions/0006-run-time-instruction-set-choice.md has their costs).
 constexpr double kPassSeconds = 100e-6;
 constexpr std::size_t kGroup = 64;
 /// Timed rounds, after one warm-up round.

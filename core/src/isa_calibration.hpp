@@ -31,7 +31,7 @@
 // than the fast ones. The ISAs alternate within each of 5 timed rounds, the
 // first rotating from round to round; each ISA keeps its best pass, and the
 // lowest wins. What a key costs is paid by the first solve of its kind
-// (SolveStats::isa_calibration_seconds; docs/decisions/0006 has the cost).
+// (SolveStats::isa_calibration_seconds; docs/decisions/0006-run-time-instruction-set-choice.md has the cost).
 //
 // In cache the kernel's own cost decides, which is where the ISAs differ;
 // where memory bounds a large solve, every ISA waits on the same lines.
