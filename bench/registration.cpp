@@ -208,6 +208,17 @@ void register_rows(const Options& options, std::size_t file_contacts) {
                     [=](benchmark::State& s) { order_row<float>(s, kind, size, order, passes, threads); });
           }
         }
+        // Both iteration modes, per pass, on the scenes whose bodies share
+        // contacts, on two threads: the accumulated passes' cost against the
+        // repeated ones', the residual of each in the label.
+        if (kind == Kind::pile || kind == Kind::debris) {
+          for (const collide::Iteration iteration : {collide::Iteration::repeat, collide::Iteration::accumulate}) {
+            for (const int passes : {1, 4, 16}) {
+              add_row(iterate_name(kind, "f32", order, iteration, passes, 2, size),
+                      [=](benchmark::State& s) { order_row<float>(s, kind, size, order, passes, 2, iteration); });
+            }
+          }
+        }
         // The order's memory-only twin: the ceiling of its index pattern.
         add_row(order_twin_name(kind, "f32", order, 2, size),
                 [=](benchmark::State& s) { order_twin_row<float>(s, kind, size, order, 2); });

@@ -70,6 +70,12 @@ std::string order_name(Kind kind, const char* precision, collide::Order order, i
          "/passes:" + std::to_string(passes) + threads_and_n(threads, n);
 }
 
+std::string iterate_name(Kind kind, const char* precision, collide::Order order, collide::Iteration iteration,
+                         int passes, int threads, std::size_t n) {
+  return std::string("iterate/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(order) + "/" +
+         collide::to_string(iteration) + "/passes:" + std::to_string(passes) + threads_and_n(threads, n);
+}
+
 std::string order_twin_name(Kind kind, const char* precision, collide::Order order, int threads, std::size_t n) {
   return std::string("order_twin/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(order) +
          threads_and_n(threads, n);

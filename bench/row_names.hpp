@@ -59,6 +59,10 @@ std::string schedule_name(Kind kind, const char* precision, std::size_t n,
 /// "order/<scene>/<prec>/<input|colour>/passes:P/t:T/n:N": a solve in that
 /// order with P passes per schedule.
 std::string order_name(Kind kind, const char* precision, collide::Order order, int passes, int threads, std::size_t n);
+/// The iteration modes of an order's passes side by side: per pass, and the
+/// residual in the label.
+std::string iterate_name(Kind kind, const char* precision, collide::Order order, collide::Iteration iteration,
+                         int passes, int threads, std::size_t n);
 std::string order_twin_name(Kind kind, const char* precision, collide::Order order, int threads, std::size_t n);
 
 }  // namespace collide_bench

@@ -28,6 +28,7 @@
 
 #include <oneapi/tbb/task_arena.h>
 
+#include <cstdio>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -286,13 +287,15 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
 }
 
 template <class T>
-void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads) {
+void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads,
+               collide::Iteration iteration) {
   Prepared<T>& p = prepared_scene<T>(kind, n);
   measure_isa_auto<T>(collide::Model::rigid);
   collide::SolverOptions options;
   options.threads = threads;
   options.order = order;
   options.passes = passes;
+  options.iteration = iteration;
   const collide::Solver solver(options);
   collide::Schedule schedule(order);  // untimed: a schedule serves every frame while the contacts hold
   const collide::BodyView<T> bodies = p.bodies();
@@ -307,9 +310,15 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   columns.batches = static_cast<double>(stats.batches);
   columns.schedule_bytes_per_contact = static_cast<double>(schedule.memory_bytes()) / static_cast<double>(n);
   set_counters(state, columns);
-  state.SetLabel(cache_label(p, std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) +
-                                    ", " + std::to_string(stats.colours) + " colours, " +
-                                    std::to_string(stats.overflow_contacts) + " overflow"));
+  std::string label = std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) + ", " +
+                      std::to_string(stats.colours) + " colours, " + std::to_string(stats.overflow_contacts) +
+                      " overflow";
+  if (passes > 1) {
+    char residual[32];
+    std::snprintf(residual, sizeof residual, ", residual %.3g", stats.residual);
+    label += residual;
+  }
+  state.SetLabel(cache_label(p, label));
 }
 
 /// The packed twin (packed_twin.hpp: every byte the solve reads and writes,
@@ -335,7 +344,7 @@ void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::
   template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
   template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
   template void schedule_row<T>(benchmark::State&, Kind, std::size_t, collide::Order);                            \
-  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int);                     \
+  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int, collide::Iteration); \
   template void order_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int);
 COLLIDE_BENCH_ROWS(float)
 COLLIDE_BENCH_ROWS(double)

@@ -50,7 +50,8 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
 /// order/ rows: the rigid model through Solver::solve (SIMD, Isa::automatic)
 /// in `order` with `passes` passes; the rate counts every pass's contacts.
 template <class T>
-void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads);
+void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads,
+               collide::Iteration iteration = collide::Iteration::repeat);
 /// order_twin/<scene>/f32/<order>/t:T/n:N: the packed twin walked in that
 /// order's schedule (rows.cpp).
 template <class T>

@@ -71,6 +71,7 @@ const char* const kSolveUsage =
     "                     [--path simd|scalar]\n"
     "                     [--isa auto|sse2|avx2|avx512] [--layout auto|soa|packed]\n"
     "                     [--accuracy fast|accurate] [--order input|colour] [--passes N]\n"
+    "                     [--iteration repeat|accumulate]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
@@ -109,8 +110,12 @@ const char* const kSolveUsage =
     "                        (windows of contacts coloured over their bodies and solved\n"
     "                        colour by colour: several times faster on piles, stacks\n"
     "                        and chains; docs/collision-law.md, 'The solve order')\n"
-    "  --passes N            resolve the contacts N times in that order (default 1);\n"
-    "                        J is the sum over the passes\n"
+    "  --passes N            resolve the contacts N times in that order (default 1)\n"
+    "  --iteration I         what the passes after the first do: repeat (default: the\n"
+    "                        law again, J the sum over the passes) or accumulate\n"
+    "                        (each contact's total impulse moved towards rest and\n"
+    "                        clamped, restitution once, J the totals: converges as\n"
+    "                        physics engines' passes do; fast accuracy only)\n"
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
@@ -143,6 +148,7 @@ struct SolveRequest {
   Accuracy accuracy = Accuracy::fast;
   Order order = Order::input;
   int passes = 1;
+  Iteration iteration = Iteration::repeat;
   bool auto_model = true;
   Model model = Model::rigid;
   bool stats = false;
@@ -188,6 +194,7 @@ int solve_scene(const SolveRequest& req) {
   options.accuracy = req.accuracy;
   options.order = req.order;
   options.passes = req.passes;
+  options.iteration = req.iteration;
   const Solver solver(options);
   ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
@@ -202,7 +209,7 @@ int solve_scene(const SolveRequest& req) {
     std::vector<ReferenceContact<long double>> diag(contacts.size());
     // In the solve's own sequence: its schedule's order, pass after pass.
     reference_solve<long double>(ref_bodies.view(), ref_contacts.view(), ref_impulses.view(), diag.data(),
-                                 SolveSequence{schedule.order(), static_cast<std::size_t>(req.passes)});
+                                 SolveSequence{schedule.order(), static_cast<std::size_t>(req.passes), req.iteration});
     check = check_impulses<T>(std::as_const(impulses).view(), std::as_const(ref_impulses).view(), diag);
     check_seconds = seconds_since(t_check);
   }
@@ -293,6 +300,7 @@ int run_solve(int argc, char** argv) {
                                      {"accuracy", true},
                                      {"order", true},
                                      {"passes", true},
+                                     {"iteration", true},
                                      {"model", true},
                                      {"stats", false},
                                      {"check", false},
@@ -396,6 +404,16 @@ int run_solve(int argc, char** argv) {
   }
   if (const auto it = opt.find("passes"); it != opt.end()) {
     req.passes = static_cast<int>(parse_integer("passes", it->second, 1, kMaxPasses));
+  }
+  if (const auto it = opt.find("iteration"); it != opt.end()) {
+    try {
+      req.iteration = parse_iteration(it->second);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--iteration: ") + e.what());
+    }
+    if (req.iteration == Iteration::accumulate && req.accuracy == Accuracy::accurate) {
+      throw UsageError("--iteration accumulate runs in the fast mode: it takes --accuracy fast");
+    }
   }
   if (const auto it = opt.find("layout"); it != opt.end()) {
     if (it->second == "auto") {

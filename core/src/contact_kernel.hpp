@@ -293,11 +293,14 @@ COLLIDE_LANE_INLINE SlidingDirection<V> sliding_direction(const Vec3<V>& ut) {
 }
 
 /// The normal impulse of W contacts: which lanes act (approaching, K(n) > 0)
-/// and jn there (0 elsewhere).
+/// and jn there (0 elsewhere), and the approach speed vn = u . n it came
+/// from (of the stored n in the fast mode), which the accumulated passes
+/// keep for their restitution target.
 template <class V>
 struct NormalImpulse {
   typename V::mask_type approaching;
   V jn;
+  V vn;
 };
 
 /// |n|^2 - 1 of a stored double normal, to about eps^2 (not eps): each
@@ -399,6 +402,7 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
     W d = (A::widen(a.inv_mass) + A::widen(b.inv_mass)) * dot(nw, nw);
     if constexpr (kRotates<M>) d = (d + A::widen(arm_a.k)) + A::widen(arm_b.k);
     r.approaching = (vn < V(0)) && (k_n > V(0));
+    r.vn = vn;
     // Inactive lanes may divide by zero here; their result is discarded.
     r.jn = select(r.approaching, A::narrow(-((W(1) + A::widen(e)) * vn_w) / d), V(0));
   } else {
@@ -407,6 +411,7 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
       const V vn = dot(u, n);
       const V d = k_n + (a.inv_mass + b.inv_mass) * excess;
       r.approaching = (vn < V(0)) && (k_n > V(0));
+      r.vn = vn;
       r.jn = select(r.approaching, -((V(1) + e) * vn) / d, V(0));
     } else {
       (void)u;
@@ -416,6 +421,7 @@ COLLIDE_LANE_INLINE NormalImpulse<V> fast_normal_impulse(const BodyLanes<M, V>& 
       V dh, dl;
       fast_two_sum(kh, kl + kh * excess, dh, dl);  // |kh| >= |kl + kh excess|
       r.approaching = (vh < V(0)) && (k_n > V(0));
+      r.vn = vh;
       r.jn = select(r.approaching, compensated_normal_impulse(vh, vl, e, dh, dl), V(0));
     }
   }
@@ -478,6 +484,7 @@ COLLIDE_LANE_INLINE NormalImpulse<V> normal_impulse(const BodyLanes<M, V>& a, co
     const V vn = dot(u, n);
     const V k_n = inverse_effective_mass(a, b, g.arm_a, g.arm_b);
     normal.approaching = (vn < V(0)) && (k_n > V(0));
+    normal.vn = vn;
     // Inactive lanes may divide by zero here; their result is discarded.
     normal.jn = select(normal.approaching, -((V(1) + contact.e) * vn) / k_n, V(0));
   }
@@ -487,10 +494,13 @@ COLLIDE_LANE_INLINE NormalImpulse<V> normal_impulse(const BodyLanes<M, V>& a, co
 /// The Coulomb step of W contacts after their normal impulse (jn, applied
 /// where `approaching`): stops the sliding where the cone allows, and adds
 /// the friction impulse to `j`. Reads the bodies' velocities and, for the
-/// lever arms along the sliding direction, their geometry.
+/// lever arms along the sliding direction, their geometry. With `taken`,
+/// leaves there the impulse taken from a, jt t (0 where nothing slides): the
+/// first accumulated pass's friction total.
 template <class M, class V, class Mode>
 COLLIDE_LANE_INLINE void coulomb_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b, const ContactLanes<V>& contact,
-                                      const ContactGeometry<V>& g, const NormalImpulse<V>& normal, Vec3<V>& j) {
+                                      const ContactGeometry<V>& g, const NormalImpulse<V>& normal, Vec3<V>& j,
+                                      Vec3<V>* taken = nullptr) {
   const Vec3<V>& n = contact.n;
   const auto may_slide = normal.approaching && (contact.mu > V(0));
   if (!stdx::any_of(may_slide)) return;
@@ -521,7 +531,9 @@ COLLIDE_LANE_INLINE void coulomb_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b, co
   if constexpr (std::is_same_v<Mode, FastMode>) cap = cap * lane_sqrt(dot(n, n));
   const V jt = select(sliding, lane_min(slide.speed / k_t, cap), V(0));
   apply_impulse(a, b, t, -jt, tarm_a, tarm_b, sliding);
-  j = select(sliding, j - t * jt, j);
+  const Vec3<V> friction = t * jt;
+  j = select(sliding, j - friction, j);
+  if (taken != nullptr) *taken = select(sliding, friction, Vec3<V>{V(0), V(0), V(0)});
 }
 
 /// The velocity step of W contacts whose bodies are pairwise distinct (or
@@ -654,6 +666,125 @@ COLLIDE_LANE_INLINE ContactResult<V> resolve_contacts(BodyLanes<M, V>& a, BodyLa
   }
   canonical_outputs(a, b, r.j);
   return r;
+}
+
+// The accumulated passes (Iteration::accumulate)
+// -----------------------------------------------
+// Sequential impulses with accumulated totals, as Box2D's b2SolveContact and
+// Jolt's AxisConstraintPart iterate: each contact keeps its total normal
+// impulse lambda (P = lambda n, n as stored) and its total friction impulse
+// G (the impulse on a is -G), and a pass moves the totals instead of adding
+// impulses that can never be taken back.
+//
+// The first pass is the law itself (resolve_contacts' operations, so one
+// pass from zero is the repeat mode's bit for bit), and it records
+//     lambda = jn,   G = jt t,   target = -e vn  (0 where the contact does not approach),
+// vn the approach speed at the contact's first visit: restitution is asked
+// for once, as a target normal velocity, not re-applied by every pass. A
+// later pass, with D = |n|^2 (1/ma + 1/mb) + ka(n) + kb(n) as in the fast
+// mode's normal impulse (so that u . n moves by D per unit of lambda),
+//     lambda' = max(lambda + (target - u . n) / D, 0),   apply (lambda' - lambda) n,
+// which can take back what the passes before gave too much; then, with
+// friction, the impulse that would stop the sliding, |ut| / K(t) along t,
+// is added to G and the sum clamped to the cone |G'| <= mu lambda' |n|:
+//     G' = clamp(G + t |ut| / K(t)),   apply -(G' - G),
+// along G' - G itself (its own lever arms). A lane whose totals do not move
+// keeps its velocities bit for bit, as in the law.
+
+/// The totals of W contacts between passes.
+template <class V>
+struct Accumulated {
+  V normal;          // lambda: the normal impulse is lambda n [N s / |n|]
+  V target;          // the u . n the passes drive towards [m/s |n|]
+  Vec3<V> friction;  // G: the friction impulse on a is -G [N s]
+};
+
+/// The first accumulated pass of W contacts in the fast mode, given their
+/// geometry: the law's velocity step (velocity_step), and the totals it
+/// leaves in `acc`.
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> first_accumulated_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                            const ContactLanes<V>& contact, const ContactGeometry<V>& g,
+                                                            Accumulated<V>& acc) {
+  const NormalImpulse<V> normal = normal_impulse<M, V, FastMode>(a, b, contact, g);
+  apply_impulse(a, b, contact.n, normal.jn, g.arm_a, g.arm_b, normal.approaching);
+  ContactResult<V> result{contact.n * normal.jn};
+  acc.normal = normal.jn;
+  acc.target = select(normal.approaching, V(0) - contact.e * normal.vn, V(0));
+  acc.friction = {V(0), V(0), V(0)};
+  if constexpr (kFriction) coulomb_step<M, V, FastMode>(a, b, contact, g, normal, result.j, &acc.friction);
+  canonical_outputs(a, b, result.j);
+  return result;
+}
+
+/// The friction part of a later accumulated pass: G moved by the impulse
+/// that stops the sliding, clamped to the cone of the normal total.
+template <class M, class V>
+COLLIDE_LANE_INLINE void accumulated_coulomb_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                  const ContactLanes<V>& contact, const ContactGeometry<V>& g,
+                                                  const typename V::mask_type& movable, Accumulated<V>& acc) {
+  const Vec3<V>& n = contact.n;
+  const auto may_slide = movable && (contact.mu > V(0));
+  if (!stdx::any_of(may_slide)) return;
+  const Vec3<V> u_after = relative_velocity(a, b, g.ra, g.rb);
+  const Vec3<V> ut = u_after - n * (dot(u_after, n) / dot(n, n));
+  const SlidingDirection<V> slide = sliding_direction(ut);
+  const auto sliding = may_slide && (slide.scaled_length > V(0)) && (slide.scaled_length < V(kInfinity<V>));
+  const Vec3<V> t = slide.unit * (V(1) / select(sliding, slide.scaled_length, V(1)));
+  const LeverArm<V> tarm_a = lever_arm(a, g.ra, t, contact.c);
+  const LeverArm<V> tarm_b = lever_arm(b, g.rb, t, contact.c);
+  const V k_t = inverse_effective_mass(a, b, tarm_a, tarm_b);
+  const V stop = select(sliding, slide.speed / k_t, V(0));
+  const Vec3<V> wanted = acc.friction + t * stop;
+  const V cap = (contact.mu * acc.normal) * lane_sqrt(dot(n, n));
+  const V length = lane_sqrt(dot(wanted, wanted));
+  // length > cap >= 0 never divides by zero; a NaN length keeps `wanted`.
+  const V scale = select(length > cap, cap / select(length > cap, length, V(1)), V(1));
+  const Vec3<V> friction = select(may_slide, wanted * scale, acc.friction);
+  const Vec3<V> step = friction - acc.friction;
+  const auto moves = may_slide && ((step.x != V(0)) || (step.y != V(0)) || (step.z != V(0)));
+  const LeverArm<V> sarm_a = lever_arm(a, g.ra, step, contact.c);
+  const LeverArm<V> sarm_b = lever_arm(b, g.rb, step, contact.c);
+  apply_impulse(a, b, step, V(-1), sarm_a, sarm_b, moves);
+  acc.friction = friction;
+}
+
+/// A later accumulated pass of W contacts in the fast mode, given their
+/// geometry, from the totals in `acc`, which it moves.
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> accumulated_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                      const ContactLanes<V>& contact, const ContactGeometry<V>& g,
+                                                      Accumulated<V>& acc) {
+  const Vec3<V>& n = contact.n;
+  const V vn = dot(relative_velocity(a, b, g.ra, g.rb), n);
+  const auto movable = inverse_effective_mass(a, b, g.arm_a, g.arm_b) > V(0);
+  V d = (a.inv_mass + b.inv_mass) * dot(n, n);
+  if constexpr (kRotates<M>) d = (d + g.arm_a.k) + g.arm_b.k;
+  const V total = acc.normal + (acc.target - vn) / select(movable, d, V(1));
+  // A NaN total compares false: the normal total drops to 0.
+  const V normal = select(movable && (total > V(0)), total, V(0));
+  const V step = normal - acc.normal;
+  apply_impulse(a, b, n, step, g.arm_a, g.arm_b, movable && (step != V(0)));
+  acc.normal = normal;
+  if constexpr (kFriction) accumulated_coulomb_step(a, b, contact, g, movable, acc);
+  ContactResult<V> result{n * acc.normal - acc.friction};
+  canonical_outputs(a, b, result.j);
+  return result;
+}
+
+/// The two accumulated passes with their geometry formed first (as
+/// evaluate_law composes the law's halves).
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> first_accumulated_pass(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                            const ContactLanes<V>& contact, Accumulated<V>& acc) {
+  const ContactGeometry<V> g = contact_geometry(a, b, contact);
+  return first_accumulated_step<M, V, kFriction>(a, b, contact, g, acc);
+}
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE ContactResult<V> accumulated_pass(BodyLanes<M, V>& a, BodyLanes<M, V>& b,
+                                                      const ContactLanes<V>& contact, Accumulated<V>& acc) {
+  const ContactGeometry<V> g = contact_geometry(a, b, contact);
+  return accumulated_step<M, V, kFriction>(a, b, contact, g, acc);
 }
 
 }  // namespace COLLIDE_KERNEL_NS

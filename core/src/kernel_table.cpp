@@ -38,6 +38,19 @@ JobKernels<T> job_kernels(const KernelTable& table, const KernelJob<T>& job, boo
   const std::size_t friction = job.friction ? 1 : 0;
   const std::size_t layout = job.packed ? 1 : 0;
   JobKernels<T> k;
+  if (job.accumulates()) {
+    // Runs of tiny batches take the one-lane loop contact by contact; the
+    // geometry a prepared solve forms once is the repeat mode's.
+    k.one_lane = job.stepped ? one_lane.accumulate_step[model][layout] : one_lane.accumulate[model][friction][layout];
+    if (simd) {
+      k.groups =
+          job.stepped ? loops.groups.accumulate_step[model][layout] : loops.groups.accumulate[model][friction][layout];
+    } else {
+      k.groups = k.one_lane;
+    }
+    if (!job.accurate && !job.friction) k.geometry = loops.geometry[model][layout];
+    return k;
+  }
   k.one_lane = job.stepped ? one_lane.step[model][layout] : one_lane.solve[model][mode][friction][layout];
   if (simd) {
     k.groups = job.stepped ? loops.groups.step[model][layout] : loops.groups.solve[model][mode][friction][layout];

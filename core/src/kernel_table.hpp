@@ -83,6 +83,16 @@ struct GeometryView {
   }
 };
 
+/// The totals of the accumulated passes (Iteration::accumulate;
+/// contact_kernel.hpp, Accumulated), one array per value, indexed as J is:
+/// by the job's contact index.
+template <class T>
+struct AccumulatedView {
+  T* normal = nullptr;  ///< lambda [N s / |n|]: the normal impulse is lambda n
+  T* target = nullptr;  ///< [m/s |n|] the u . n the passes drive towards
+  T* friction[3] = {};  ///< G [N s]: the friction impulse on a is -G (with friction only)
+};
+
 /// Everything a kernel needs besides the range: the bodies in the view of
 /// `model` and layout (only that member is set), the contacts, where J goes,
 /// and the schedule's order.
@@ -109,6 +119,12 @@ struct KernelJob {
   /// take the velocity step alone, on the geometry stored there.
   bool stepped = false;
   GeometryView<T> geometry;
+  /// Set for Iteration::accumulate (fast mode, never stepped): each pass
+  /// writes J and moves the totals there (the first pass records them).
+  AccumulatedView<T> accumulated;
+  bool first_pass = false;  ///< the accumulated pass is the first: the law, recording the totals
+
+  [[nodiscard]] bool accumulates() const { return accumulated.normal != nullptr; }
 };
 
 /// Resolves order[begin, end) (all inside one batch; `contiguous` when the
@@ -183,6 +199,12 @@ struct GroupLoops {
   /// The velocity step on the stored geometry (KernelJob::stepped: fast
   /// mode, frictionless): step[model][packed].
   GroupLoop<T> step[kModels][kLayouts] = {};
+  /// The accumulated passes (KernelJob::accumulates: fast mode):
+  /// accumulate[model][friction][packed].
+  GroupLoop<T> accumulate[kModels][kFrictions][kLayouts] = {};
+  /// The same on the stored geometry (KernelJob::stepped: frictionless):
+  /// accumulate_step[model][packed].
+  GroupLoop<T> accumulate_step[kModels][kLayouts] = {};
 };
 
 /// The loops of one instruction set and precision: the group loops in its
@@ -243,7 +265,8 @@ struct JobKernels {
   GroupLoop<T> one_lane = nullptr;
   /// A run in pieces (fast mode, frictionless, not stepped); otherwise null.
   RunKernel<T> run_pieces = nullptr;
-  /// The two halves of a run (fast mode, frictionless); otherwise null.
+  /// The two halves of a run (fast mode, frictionless, repeated passes);
+  /// otherwise null. (The accumulated passes' runs take the one-lane loop.)
   RunGeometryKernel<T> geometry = nullptr;
   RunWalkKernel<T> walk = nullptr;
 
@@ -259,7 +282,7 @@ struct JobKernels {
   /// alone; the accurate mode and friction take the one-lane loop, contact by
   /// contact.
   void run(const KernelJob<T>& job, std::size_t begin, std::size_t end) const {
-    if (job.stepped) {
+    if (job.stepped && walk != nullptr) {
       walk(job, begin, end - begin, job.geometry.from(begin));
     } else if (run_pieces != nullptr) {
       run_pieces(job, begin, end);

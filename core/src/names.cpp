@@ -31,6 +31,14 @@ Accuracy parse_accuracy(std::string_view name) {
   throw std::invalid_argument("unknown accuracy '" + std::string(name) + "' (expected fast or accurate)");
 }
 
+const char* to_string(Iteration iteration) { return iteration == Iteration::accumulate ? "accumulate" : "repeat"; }
+
+Iteration parse_iteration(std::string_view name) {
+  if (name == "repeat") return Iteration::repeat;
+  if (name == "accumulate") return Iteration::accumulate;
+  throw std::invalid_argument("unknown iteration '" + std::string(name) + "' (expected repeat or accumulate)");
+}
+
 const char* to_string(Order order) { return order == Order::colour ? "colour" : "input"; }
 
 Order parse_order(std::string_view name) {

@@ -47,7 +47,16 @@ class Walk {
         kernels_(job_kernels(table, job, plan.simd)),
         first_(job),
         later_(job) {
-    later_.accumulate = true;
+    // The repeat mode adds each later pass's J; the accumulated passes write
+    // J (their totals), the first recording the totals. A walk that
+    // continues a solve has no first pass.
+    if (job.accumulates()) {
+      first_.first_pass = !plan.continues;
+      later_.first_pass = false;
+    } else {
+      later_.accumulate = true;
+      first_.accumulate = plan.continues;
+    }
   }
 
   /// What every thread of the walk does, thread `worker` of the arena's:
@@ -172,7 +181,7 @@ class Walk {
         kernels_.range(job, consecutive(k), begin, stop);
       } else if (!plan_.simd) {
         kernels_.one_lane(job, false, begin, stop);
-      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction && !job.stepped &&
+      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction && !job.stepped && !job.accumulates() &&
                  stop - begin >= kPipelinedRunPieces * kRunPiece) {
         run_pipelined(job, begin, stop);
       } else {

@@ -63,11 +63,15 @@ struct WalkPlan {
   /// The job's contacts are in the schedule's order (prepared_contacts.hpp):
   /// every batch's contacts are consecutive in its arrays.
   bool prepared = false;
+  /// The walk continues a solve whose earlier passes have run: its first
+  /// pass is a later one (J added, or the totals moved).
+  bool continues = false;
 };
 
 /// Resolves every contact of `schedule` `plan.passes` times with `job`'s
 /// kernels from `table`, on the threads of `arena`. The first pass writes J,
-/// the later ones add to it. Returns the passes run: plan.passes, or fewer
+/// the later ones add to it (or, accumulating, move the totals and write
+/// J); with plan.continues every pass is a later one. Returns the passes run: plan.passes, or fewer
 /// when plan.stop was set (at least one; plan.passes for an empty schedule).
 template <class T>
 std::size_t walk_schedule(const KernelTable& table, const WalkPlan& plan, tbb::task_arena& arena,

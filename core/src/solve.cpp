@@ -27,6 +27,7 @@
 //   its buffers sized reports 0.
 #include <cassert>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -39,6 +40,7 @@
 #include "collide/solve.hpp"
 #include "collide/validate.hpp"
 #include "first_touch.hpp"
+#include "iteration_scratch.hpp"
 #include "kernel_table.hpp"
 #include "prepared_contacts.hpp"
 #include "run_schedule.hpp"
@@ -69,6 +71,21 @@ struct Solver::Impl {
   std::mutex prepare_mutex;
   detail::PreparedContacts<float> prepared_f;
   detail::PreparedContacts<double> prepared_d;
+
+  // What a solve of several passes keeps between them (the accumulated
+  // totals, J before the last pass); such solves on one Solver take turns.
+  std::mutex iteration_mutex;
+  detail::IterationScratch<float> iteration_f;
+  detail::IterationScratch<double> iteration_d;
+
+  template <class T>
+  detail::IterationScratch<T>& iteration() {
+    if constexpr (std::is_same_v<T, float>) {
+      return iteration_f;
+    } else {
+      return iteration_d;
+    }
+  }
 
   template <class T>
   detail::PreparedContacts<T>& prepared() {
@@ -141,6 +158,10 @@ void check_options(const SolverOptions& options) {
   if (options.passes < 1) {
     throw std::invalid_argument("collide::Solver: passes must be >= 1, got " + std::to_string(options.passes));
   }
+  if (options.iteration == Iteration::accumulate && options.accuracy == Accuracy::accurate) {
+    throw std::invalid_argument(
+        "collide::Solver: iteration accumulate runs in the fast mode; accuracy accurate takes iteration repeat");
+  }
 }
 
 }  // namespace
@@ -174,6 +195,39 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   plan.block = std::max<std::size_t>(plan.width, (options.block + plan.width - 1) / plan.width * plan.width);
   plan.passes = static_cast<std::size_t>(options.passes);
   plan.stop = options.stop;
+  // Several passes keep J before the last one for the residual; the
+  // accumulated passes keep their totals. Sized in the allocate phase.
+  const bool accumulates = options.iteration == Iteration::accumulate;
+  const bool measures = plan.passes > 1;
+  std::unique_lock<std::mutex> iteration_lock(iteration_mutex, std::defer_lock);
+  detail::KernelJob<T> iterated = job;
+  if (accumulates || measures) {
+    iteration_lock.lock();
+    const auto t_allocate = Clock::now();
+    if (iteration<T>().allocate(*arena, job.contacts.count, accumulates, job.friction, measures)) {
+      allocate_seconds += seconds_since(t_allocate);
+    }
+    if (accumulates) iterated.accumulated = iteration<T>().totals(job.friction);
+  }
+  double residual = 1;
+  // The passes, the last one apart when the residual is measured.
+  const auto walk = [&](const detail::KernelJob<T>& on) {
+    if (!measures) return detail::walk_schedule(table, plan, *arena, on, schedule);
+    detail::WalkPlan before = plan;
+    before.passes = plan.passes - 1;
+    const std::size_t done = detail::walk_schedule(table, before, *arena, on, schedule);
+    if (done < before.passes || (plan.stop != nullptr && plan.stop->load(std::memory_order_relaxed))) {
+      residual = std::numeric_limits<double>::quiet_NaN();
+      return done;
+    }
+    iteration<T>().save(*arena, on.impulses);
+    detail::WalkPlan last = plan;
+    last.passes = 1;
+    last.continues = true;
+    detail::walk_schedule(table, last, *arena, on, schedule);
+    residual = iteration<T>().residual(*arena, on.impulses);
+    return plan.passes;
+  };
   std::size_t passes = 0;
   if (detail::prepares_contacts(schedule)) {
     // Copied in, walked every pass, J copied out: the copies cost two
@@ -185,13 +239,13 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
     const auto t_allocate = Clock::now();
     if (prepared_contacts.allocate(*arena, job, stepped)) allocate_seconds += seconds_since(t_allocate);
-    const detail::KernelJob<T> on_prepared =
-        prepared_contacts.prepare(*arena, job, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
+    const detail::KernelJob<T> on_prepared = prepared_contacts.prepare(
+        *arena, iterated, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
     plan.prepared = true;
-    passes = detail::walk_schedule(table, plan, *arena, on_prepared, schedule);
+    passes = walk(on_prepared);
     prepared_contacts.write_back(*arena, job.impulses, schedule.order());
   } else {
-    passes = detail::walk_schedule(table, plan, *arena, job, schedule);
+    passes = walk(iterated);
   }
 
   SolveStats stats;
@@ -215,6 +269,8 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.colours = schedule.colours();
   stats.overflow_contacts = schedule.overflow_contacts();
   stats.passes = passes;
+  stats.iteration = options.iteration;
+  stats.residual = residual;
   return stats;
 }
 

@@ -185,6 +185,13 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
   // scene's chains exceeded the bound (docs/decisions/0008-the-impulse-scale.md).
   std::vector<S> inherited_v(kErrorAnalysis ? bodies.count : 0, S(0));
   std::vector<S> inherited_w(kErrorAnalysis ? bodies.count : 0, S(0));
+  // The accumulated passes' totals (Iteration::accumulate): the normal
+  // impulse lambda n, the target u . n, and the friction impulse -G taken
+  // from a. The first pass is the law and records them.
+  const bool accumulates = sequence.iteration == Iteration::accumulate;
+  std::vector<S> total_normal(accumulates ? contacts.count : 0, S(0));
+  std::vector<S> target(accumulates ? contacts.count : 0, S(0));
+  std::vector<Vec<S>> total_friction(accumulates ? contacts.count : 0);
   for (std::size_t step = 0; step < sequence.passes * contacts.count; ++step) {
     const std::size_t pass = step / contacts.count;
     const std::size_t at = step % contacts.count;
@@ -272,7 +279,58 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
         own_scale = (S(1) + e) * (own_before + lever) / d.k_n;
       }
     }
-    if (d.vn < S(0) && d.k_n != S(0)) {
+    // The friction step's share of the scale (see below), for a normal
+    // impulse jn and a friction impulse jt along t.
+    [[maybe_unused]] auto friction_scale = [&](S normal_scale, S before, S after, S jn, S jt, const V3& t, S k_t) {
+      const S after_normal = normal_scale * compliance_times(n).norm() +
+                             jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
+      return (S(1) + mu) * normal_scale +
+             (before + after + after_normal) / k_t * (S(1) + compliance_times(t).norm() / k_t) +
+             jt * lever_sensitivity(t) / k_t;
+    };
+    if (accumulates && pass > 0) {
+      // A later accumulated pass (docs/collision-law.md, "Iteration"): the
+      // normal total moved towards the target and clamped at 0, then the
+      // friction total moved by what stops the sliding and clamped to the
+      // cone of the normal total.
+      if (d.k_n != S(0)) {
+        const S total = total_normal[k] + (target[k] - d.vn) / d.k_n;
+        const S normal = total > S(0) ? total : S(0);
+        d.jn = normal;
+        apply((normal - total_normal[k]) * n);
+        total_normal[k] = normal;
+        if (mu > S(0)) {
+          const V3 u2 = relative_velocity();
+          const V3 ut = u2 - u2.dot(n) * n;
+          const S ut_len = ut.norm();
+          V3 t = V3::Zero();
+          S stop = 0;
+          if (ut_len > S(0)) {
+            t = ut / ut_len;
+            d.k_t = inv_effective_mass(t);
+            stop = ut_len / d.k_t;
+          }
+          const V3 wanted = total_friction[k] + t * stop;
+          const S cap = mu * normal;
+          const S len = wanted.norm();
+          const V3 friction = len > cap ? wanted * (cap / len) : wanted;
+          d.jt = friction.norm();
+          if constexpr (kErrorAnalysis) {
+            if (ut_len > S(0)) {
+              const S own_after = own_speed_scale();
+              d.impulse_scale =
+                  friction_scale(d.impulse_scale, d.speed_scale, own_after + inherited_speed(), d.jn, d.jt, t, d.k_t);
+              own_scale = friction_scale(own_scale, own_before, own_after, d.jn, d.jt, t, d.k_t);
+            }
+          }
+          apply(total_friction[k] - friction);
+          total_friction[k] = friction;
+        }
+        a.store(bodies, ia);
+        b.store(bodies, ib);
+      }
+      j = total_normal[k] * n - total_friction[k];
+    } else if (d.vn < S(0) && d.k_n != S(0)) {
       d.jn = -(S(1) + e) * d.vn / d.k_n;
       apply(d.jn * n);
       j = d.jn * n;
@@ -309,26 +367,25 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
           // impulse"; docs/decisions/0008-the-impulse-scale.md).
           if constexpr (kErrorAnalysis) {
             const S own_after = own_speed_scale();
-            auto with_friction = [&](S normal_scale, S before, S after) {
-              const S after_normal =
-                  normal_scale * compliance_times(n).norm() +
-                  d.jn * (a.inv_inertia_max * ra.squaredNorm() + b.inv_inertia_max * rb.squaredNorm());
-              return (S(1) + mu) * normal_scale +
-                     (before + after + after_normal) / d.k_t * (S(1) + compliance_times(t).norm() / d.k_t) +
-                     d.jt * lever_sensitivity(t) / d.k_t;
-            };
-            d.impulse_scale = with_friction(d.impulse_scale, d.speed_scale, own_after + inherited_speed());
-            own_scale = with_friction(own_scale, own_before, own_after);
+            d.impulse_scale =
+                friction_scale(d.impulse_scale, d.speed_scale, own_after + inherited_speed(), d.jn, d.jt, t, d.k_t);
+            own_scale = friction_scale(own_scale, own_before, own_after, d.jn, d.jt, t, d.k_t);
           }
           apply(-d.jt * t);
           j -= d.jt * t;
+          if (accumulates) total_friction[k] = d.jt * t;
         }
+      }
+      if (accumulates) {
+        total_normal[k] = d.jn;
+        target[k] = -e * d.vn;
       }
       a.store(bodies, ia);
       b.store(bodies, ib);
     }
-    // J of the passes so far plus this one's.
-    if (pass > 0) j += V3(impulses.j.x[k], impulses.j.y[k], impulses.j.z[k]);
+    // J of the passes so far plus this one's (the accumulated passes' J is
+    // their totals).
+    if (pass > 0 && !accumulates) j += V3(impulses.j.x[k], impulses.j.y[k], impulses.j.z[k]);
     impulses.j.x[k] = j.x();
     impulses.j.y[k] = j.y();
     impulses.j.z[k] = j.z();

@@ -14,6 +14,7 @@ PathName = Literal["simd", "scalar"]
 IsaName = Literal["auto", "sse2", "avx2", "avx512"]
 AccuracyName = Literal["fast", "accurate"]
 OrderName = Literal["input", "colour"]
+IterationName = Literal["repeat", "accumulate"]
 
 __version__: str
 error_bound_eps: float
@@ -141,6 +142,7 @@ class Solver:
     accuracy: AccuracyName
     order: OrderName
     passes: int
+    iteration: IterationName
     def __init__(
         self,
         *,
@@ -150,6 +152,7 @@ class Solver:
         accuracy: AccuracyName = "fast",
         order: OrderName = "input",
         passes: SupportsIndex = 1,
+        iteration: IterationName = "repeat",
     ) -> None:
         """``threads`` from 0 (all) to 4096 and ``passes`` from 1 to 1000000,
         as the command's options: TypeError for a value that is not an
@@ -191,6 +194,7 @@ def solve(
     accuracy: AccuracyName = "fast",
     order: OrderName = "input",
     passes: SupportsIndex = 1,
+    iteration: IterationName = "repeat",
     schedule: Schedule | None = None,
     out: FloatArray | None = None,
     check: bool = True,
@@ -216,6 +220,7 @@ def reference_solve(
     *,
     order: OrderName = "input",
     passes: SupportsIndex = 1,
+    iteration: IterationName = "repeat",
     schedule: Schedule | None = None,
 ) -> Reference: ...
 def conservation_drift(bodies: AnyBodies, reference: Reference) -> dict[str, float]: ...

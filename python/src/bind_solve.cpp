@@ -74,10 +74,12 @@ int passes_argument(const py::object& passes) {
 }
 
 SolverOptions solver_options(const std::string& path, const py::object& threads, const py::object& isa,
-                             const std::string& accuracy, const std::string& order, const py::object& passes) {
+                             const std::string& accuracy, const std::string& order, const py::object& passes,
+                             const std::string& iteration) {
   SolverOptions o;
   o.order = parse_order(order);
   o.passes = passes_argument(passes);
+  o.iteration = parse_iteration(iteration);
   o.path = parse_path(path);
   o.threads = static_cast<int>(integer_argument(threads, "threads", 0, kMaxThreads));
   std::optional<std::string> isa_name;
@@ -88,6 +90,9 @@ SolverOptions solver_options(const std::string& path, const py::object& threads,
   }
   if (isa_name) o.isa = parse_isa(*isa_name);
   o.accuracy = parse_accuracy(accuracy);
+  if (o.iteration == Iteration::accumulate && o.accuracy == Accuracy::accurate) {
+    throw py::value_error("iteration='accumulate' runs in the fast mode: it takes accuracy='fast'");
+  }
   return o;
 }
 
@@ -153,8 +158,9 @@ struct PySolver {
   std::unique_ptr<Solver> solver;
 
   PySolver(const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
-           const std::string& order, const py::object& passes)
-      : solver(std::make_unique<Solver>(stoppable(solver_options(path, threads, isa, accuracy, order, passes)))) {}
+           const std::string& order, const py::object& passes, const std::string& iteration)
+      : solver(std::make_unique<Solver>(
+            stoppable(solver_options(path, threads, isa, accuracy, order, passes, iteration)))) {}
 
   SolverOptions stoppable(SolverOptions o) const {
     o.stop = stop.get();
@@ -283,9 +289,11 @@ struct Reference {
 };
 
 std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const std::string& order,
-                                              const py::object& passes_in, const PySchedule* schedule) {
+                                              const py::object& passes_in, const std::string& iteration_name,
+                                              const PySchedule* schedule) {
   require_same_dtype(bodies, contacts);
   const int passes = passes_argument(passes_in);
+  const Iteration iteration = parse_iteration(iteration_name);
   return with_dtype(bodies.dtype, [&](auto tag) {
     using T = decltype(tag);
     validate_or_throw<T>(bodies, contacts);
@@ -300,7 +308,7 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
                             " contacts and " + std::to_string(schedule->bodies) + " bodies, not " +
                             std::to_string(contacts.count) + " and " + std::to_string(bodies.count));
     }
-    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes)};
+    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes), iteration};
     auto r = std::make_shared<Reference>();
     r->dtype = bodies.dtype;
     const BodyView<T> bv = bodies.view<T>();
@@ -410,22 +418,24 @@ void register_solve(py::module_& m) {
 
   py::class_<PySolver>(m, "Solver")
       .def(py::init<const std::string&, const py::object&, const py::object&, const std::string&, const std::string&,
-                    const py::object&>(),
+                    const py::object&, const std::string&>(),
            py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
-           py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1)
+           py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1,
+           py::arg("iteration") = "repeat")
       .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return to_string(s.solver->isa()); })
       .def_property_readonly("accuracy", [](const PySolver& s) { return to_string(s.solver->options().accuracy); })
       .def_property_readonly("order", [](const PySolver& s) { return to_string(s.solver->options().order); })
       .def_property_readonly("passes", [](const PySolver& s) { return s.solver->options().passes; })
+      .def_property_readonly("iteration", [](const PySolver& s) { return to_string(s.solver->options().iteration); })
       .def("__repr__",
            [](const PySolver& s) {
              const SolverOptions& o = s.solver->options();
              return std::string("collide.Solver(path='") + to_string(o.path) +
                     "', threads=" + std::to_string(o.threads) + ", isa='" + to_string(s.solver->isa()) +
                     "', accuracy='" + to_string(o.accuracy) + "', order='" + to_string(o.order) +
-                    "', passes=" + std::to_string(o.passes) + ")";
+                    "', passes=" + std::to_string(o.passes) + ", iteration='" + to_string(o.iteration) + "')";
            })
       .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
@@ -465,8 +475,8 @@ void register_solve(py::module_& m) {
   m.def(
       "solve_options",
       [](const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
-         const std::string& order, const py::object& passes) {
-        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes);
+         const std::string& order, const py::object& passes, const std::string& iteration) {
+        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes, iteration);
         py::dict d;
         d["path"] = to_string(o.path);
         d["threads"] = o.threads;
@@ -474,12 +484,14 @@ void register_solve(py::module_& m) {
         d["accuracy"] = to_string(o.accuracy);
         d["order"] = to_string(o.order);
         d["passes"] = o.passes;
+        d["iteration"] = to_string(o.iteration);
         return d;
       },
       py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
-      py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1);
+      py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat");
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
-        py::arg("order") = "input", py::arg("passes") = 1, py::arg("schedule") = nullptr);
+        py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat",
+        py::arg("schedule") = nullptr);
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("conservation_drift", &conservation_drift_py, py::arg("bodies"), py::arg("reference"));
   m.attr("accurate_error_ulps") = kAccurateErrorUlps;

@@ -110,16 +110,18 @@ auto* first_slot(Array& a) {
 template <int kTable, class T, int kArray>
 struct Tag {};
 
-enum ArrayId { kSolve, kStep, kRun, kGeometry, kWalk };
+enum ArrayId { kSolve, kStep, kRun, kGeometry, kWalk, kAccumulate, kAccumulateStep };
 
 /// A slot's name: the array and the choices of its index.
 std::string slot_name(int array, std::size_t i) {
   static const char* const models[] = {"particle", "sphere", "rigid"};
-  static const char* const arrays[] = {"solve", "step", "run", "geometry", "walk"};
+  static const char* const arrays[] = {"solve", "step", "run", "geometry", "walk", "accumulate", "accumulate_step"};
   std::string name = std::string(arrays[array]) + "[";
   if (array == kSolve) {
     name += std::string(models[i / 8]) + (i / 4 % 2 ? ", accurate" : ", fast") +
             (i / 2 % 2 ? ", friction" : ", frictionless");
+  } else if (array == kAccumulate) {
+    name += std::string(models[i / 4]) + (i / 2 % 2 ? ", friction" : ", frictionless");
   } else {
     name += models[i / 2];
   }
@@ -138,16 +140,27 @@ void append(Calls& out, const std::string& table, const std::array<std::size_t, 
 template <int kTable, class T>
 class CountedGroupLoops {
  public:
-  explicit CountedGroupLoops(GroupLoops<T>& loops) : solve_(first_slot(loops.solve)), step_(first_slot(loops.step)) {}
+  explicit CountedGroupLoops(GroupLoops<T>& loops)
+      : solve_(first_slot(loops.solve)),
+        step_(first_slot(loops.step)),
+        accumulate_(first_slot(loops.accumulate)),
+        accumulate_step_(first_slot(loops.accumulate_step)) {}
   void append_to(Calls& out, const std::string& table) const {
     append<kSolve>(out, table, solve_.calls());
     append<kStep>(out, table, step_.calls());
+    append<kAccumulate>(out, table, accumulate_.calls());
+    append<kAccumulateStep>(out, table, accumulate_step_.calls());
   }
-  [[nodiscard]] bool all_filled() const { return solve_.all_filled() && step_.all_filled(); }
+  [[nodiscard]] bool all_filled() const {
+    return solve_.all_filled() && step_.all_filled() && accumulate_.all_filled() && accumulate_step_.all_filled();
+  }
 
  private:
   CountedSlots<Tag<kTable, T, kSolve>, GroupLoop<T>, kSlots<decltype(GroupLoops<T>::solve)>> solve_;
   CountedSlots<Tag<kTable, T, kStep>, GroupLoop<T>, kSlots<decltype(GroupLoops<T>::step)>> step_;
+  CountedSlots<Tag<kTable, T, kAccumulate>, GroupLoop<T>, kSlots<decltype(GroupLoops<T>::accumulate)>> accumulate_;
+  CountedSlots<Tag<kTable, T, kAccumulateStep>, GroupLoop<T>, kSlots<decltype(GroupLoops<T>::accumulate_step)>>
+      accumulate_step_;
 };
 
 /// Every slot of an ISA's loops of one precision, counted.
@@ -223,6 +236,7 @@ struct Choice {
   bool accurate = false;
   bool friction = false;
   bool packed = false;
+  bool accumulates = false;  ///< Iteration::accumulate (fast mode only)
 };
 
 std::vector<Choice> every_choice() {
@@ -230,21 +244,28 @@ std::vector<Choice> every_choice() {
   for (const Model model : {Model::particle, Model::sphere, Model::rigid}) {
     for (const bool accurate : {false, true}) {
       for (const bool friction : {false, true}) {
-        for (const bool packed : {false, true}) out.push_back({model, accurate, friction, packed});
+        for (const bool packed : {false, true}) {
+          out.push_back({model, accurate, friction, packed});
+          if (!accurate) out.push_back({model, accurate, friction, packed, true});
+        }
       }
     }
   }
   return out;
 }
 
-/// The index of a choice in GroupLoops::solve, flattened.
-std::size_t solve_index(const Choice& c) {
-  return static_cast<std::size_t>(c.model) * 8 + (c.accurate ? 4 : 0) + (c.friction ? 2 : 0) + (c.packed ? 1 : 0);
+/// The slot of a choice: its array (GroupLoops::solve, or ::accumulate) and
+/// its index there, flattened.
+std::string choice_slot(const Choice& c) {
+  const auto model = static_cast<std::size_t>(c.model);
+  if (c.accumulates) return slot_name(kAccumulate, model * 4 + (c.friction ? 2 : 0) + (c.packed ? 1 : 0));
+  return slot_name(kSolve, model * 8 + (c.accurate ? 4 : 0) + (c.friction ? 2 : 0) + (c.packed ? 1 : 0));
 }
 
 std::string describe(const Choice& c) {
   return std::string(to_string(c.model)) + (c.accurate ? " accurate" : " fast") +
-         (c.friction ? " friction" : " frictionless") + (c.packed ? " packed" : " soa");
+         (c.friction ? " friction" : " frictionless") + (c.packed ? " packed" : " soa") +
+         (c.accumulates ? " accumulate" : "");
 }
 
 /// `pairs` independent pairs (contact k joins bodies 2k and 2k + 1): one
@@ -283,6 +304,7 @@ void solve_choice(const SceneRecords<T>& records, const Choice& c, Path path, Is
   o.layout = c.packed ? BodyLayout::packed : BodyLayout::soa;
   o.order = order;
   o.passes = passes;
+  o.iteration = c.accumulates ? Iteration::accumulate : Iteration::repeat;
   const ContactView<T> contacts = scene.contacts.view();
   ASSERT_EQ(contacts.mu != nullptr, c.friction);
   const BodyView<T> bodies = scene.bodies.view();
@@ -367,7 +389,7 @@ void expect_only_its_slots(Isa isa, Path path) {
     CountedTables<kTable> counted(isa);
     ASSERT_TRUE(counted.all_filled());
     solve_choice(scene, c, path, isa, Order::input, 1);
-    const std::string slot = precision + " " + slot_name(kSolve, solve_index(c));
+    const std::string slot = precision + " " + choice_slot(c);
     // SIMD: the ISA's loop of the choice, and the one-lane loop of the same
     // choice for the tail (37 is a multiple of no width); the scalar path:
     // the one-lane loop alone.
@@ -412,8 +434,8 @@ TEST(KernelDispatch, TheCatalogueReachesEverySlot) {
     solve_catalogue<double>(isa, Path::simd);
     const Calls isa_calls = counted.isa_calls();
     const Calls one_lane_calls = counted.one_lane_calls();
-    EXPECT_EQ(isa_calls.size(), 2u * (24 + 6 + 6 + 6 + 6));
-    EXPECT_EQ(one_lane_calls.size(), 2u * (24 + 6));
+    EXPECT_EQ(isa_calls.size(), 2u * (24 + 6 + 12 + 6 + 6 + 6 + 6));
+    EXPECT_EQ(one_lane_calls.size(), 2u * (24 + 6 + 12 + 6));
     EXPECT_TRUE(never_called(isa_calls).empty()) << "never called:" << joined(never_called(isa_calls));
     EXPECT_TRUE(never_called(one_lane_calls).empty()) << "never called:" << joined(never_called(one_lane_calls));
   });

@@ -110,6 +110,8 @@ TEST(Check, ImpactsAndRecord) {
                                              "lanes",
                                              "order",
                                              "passes",
+                                             "iteration",
+                                             "residual",
                                              "batches",
                                              "largest_batch",
                                              "colours",

@@ -5,8 +5,9 @@
 // ----------------
 // * The bound can fail at every pass count: on a pile, a chain and debris
 //   (with and without friction), in the input order and the colour order, at
-//   1, 4 and 16 passes, the solve's J is within the bound, while the same J
-//   made 1% larger, or all zero, is not.
+//   1, 4 and 16 passes, in both iteration modes (repeat and accumulate), the
+//   solve's J is within the bound, while the same J made 1% larger, or all
+//   zero, is not.
 // * The scale of a pass sum stays of the size of the impulses summed: a 1%
 //   error of one contact's J alone exceeds the bound at most contacts
 //   without friction. (While the uncertainty carried along chains
@@ -60,12 +61,13 @@ struct Case {
   bool friction;
   Order order;
   int passes;
+  Iteration iteration;
 };
 
 std::string case_name(const testing::TestParamInfo<Case>& info) {
   const Case& c = info.param;
   return std::string(name(c.kind)) + (c.friction ? "_friction_" : "_") + to_string(c.order) + "_passes_" +
-         std::to_string(c.passes);
+         std::to_string(c.passes) + "_" + to_string(c.iteration);
 }
 
 class PassBound : public testing::TestWithParam<Case> {};
@@ -83,14 +85,16 @@ TEST_P(PassBound, HoldsForTheSolveAndFailsForAWrongJ) {
   SolverOptions o;
   o.order = param.order;
   o.passes = param.passes;
+  o.iteration = param.iteration;
   o.threads = 2;
   ImpulseBuffer<float> j(contacts.count);
   Solver(o).solve(bodies.view(), contacts, j.view(), schedule);
 
   ImpulseBuffer<long double> ref_j(contacts.count);
   std::vector<ReferenceContact<long double>> diag(contacts.count);
-  reference_solve<long double>(ref_bodies.view(), ref_contacts.view(), ref_j.view(), diag.data(),
-                               SolveSequence{schedule.order(), static_cast<std::size_t>(param.passes)});
+  reference_solve<long double>(
+      ref_bodies.view(), ref_contacts.view(), ref_j.view(), diag.data(),
+      SolveSequence{schedule.order(), static_cast<std::size_t>(param.passes), param.iteration});
   const ImpulseView<const long double> ref = std::as_const(ref_j).view();
 
   const ImpulseCheck solved = check_impulses<float>(std::as_const(j).view(), ref, diag);
@@ -136,7 +140,11 @@ std::vector<Case> cases() {
       {Kind::pile, false}, {Kind::pile, true}, {Kind::chain, false}, {Kind::debris, false}, {Kind::debris, true}};
   for (const auto& [kind, friction] : scenes) {
     for (const Order order : {Order::input, Order::colour}) {
-      for (const int passes : {1, 4, 16}) all.push_back({kind, friction, order, passes});
+      for (const int passes : {1, 4, 16}) {
+        for (const Iteration iteration : {Iteration::repeat, Iteration::accumulate}) {
+          all.push_back({kind, friction, order, passes, iteration});
+        }
+      }
     }
   }
   return all;

@@ -355,7 +355,8 @@ def test_a_partition_task_alone_writes_its_rows(tmp_path, elsewhere):
     common = {"bodies_path": bp, "contacts_path": cp, "body_count": len(bodies), "dtype": "float64", "friction": False,
               "outputs": outputs, "client_machine": "another kernel" if elsewhere else _tasks.machine()}
     options = cd._options(expected[3]["model"], threads=1)
-    assert options["solve"] == {"accuracy": "fast", "order": "input", "passes": 1, "threads": 1, "isa": None}
+    assert options["solve"] == {"accuracy": "fast", "order": "input", "passes": 1, "iteration": "repeat", "threads": 1,
+                                "isa": None}
     _tasks.solve_part_files(dict(common, order=None, first=0, end=50), options)
     _tasks.solve_part_files(dict(common, order=str(tmp_path / "order.npy"), first=0, end=len(order)), options)
     same_bytes(cd.Solution(*(np.load(outputs[k]) for k in "Jvw"), {}), expected)

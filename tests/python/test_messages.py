@@ -157,7 +157,7 @@ def test_every_public_type_says_what_it_holds():
     assert reprs["Reference"] == (f"collide.Reference({m} contacts, {n} bodies, of a float32 scene: J, v, w and "
                                   "impulse_scale in float64)")
     assert reprs["Solver"] == ("collide.Solver(path='simd', threads=0, isa='sse2', accuracy='fast', order='colour', "
-                               "passes=2)")
+                               "passes=2, iteration='repeat')")
     assert re.fullmatch(rf"collide\.Schedule\({m} contacts, {n} bodies, order 'colour': \d+ batch(es)?, the largest "
                         r"\d+ contacts?, \d+ colours?, \d+ overflow contacts?\)", reprs["Schedule"]), reprs["Schedule"]
     by_input = repr(collide.Schedule(bodies, contacts))

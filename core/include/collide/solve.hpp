@@ -15,6 +15,7 @@
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
 #include "collide/isa.hpp"
+#include "collide/iteration.hpp"
 #include "collide/model.hpp"
 #include "collide/packed.hpp"
 #include "collide/schedule.hpp"
@@ -23,8 +24,8 @@ namespace collide {
 
 /// How a Solver runs. The kinds of its choices stand beside what they choose
 /// between: Path and Isa in collide/isa.hpp, Accuracy in
-/// collide/accuracy.hpp, BodyLayout in collide/packed.hpp and Order in
-/// collide/schedule.hpp.
+/// collide/accuracy.hpp, BodyLayout in collide/packed.hpp, Order in
+/// collide/schedule.hpp and Iteration in collide/iteration.hpp.
 struct SolverOptions {
   Path path = Path::simd;
   /// Worker threads; 0 means every hardware thread. Results do not depend on
@@ -58,6 +59,12 @@ struct SolverOptions {
   /// same bits as that many solves with their J added in turn (every NaN
   /// the canonical one). The schedule serves every pass.
   int passes = 1;
+  /// What the passes after the first do (collide/iteration.hpp): repeat the
+  /// law, J the sum of the passes (the default), or accumulate each
+  /// contact's impulses, J their totals. One pass from zero is the same
+  /// solve either way, bit for bit. Iteration::accumulate runs in the fast
+  /// mode (the constructor refuses it with Accuracy::accurate).
+  Iteration iteration = Iteration::repeat;
   /// A flag the solve's threads read between passes, never inside one: once
   /// it reads true, a solve ends with the pass in progress, v, w and J as
   /// the passes done left them (SolveStats::passes says how many). For a
@@ -109,6 +116,14 @@ struct SolveStats {
   /// Passes run: SolverOptions::passes, or fewer when SolverOptions::stop
   /// ended the solve (at least 1).
   std::size_t passes = 1;
+  Iteration iteration = Iteration::repeat;  ///< SolverOptions::iteration
+  /// How far the passes are from converged: the largest change of a
+  /// contact's J in the last pass, |J - J before the last pass|, over the
+  /// largest |J| (docs/collision-law.md, "The residual"); 0 when every J is
+  /// 0. A solve of one pass measures nothing and reports 1 (the pass is all
+  /// of J); a solve that SolverOptions::stop ended before its last pass
+  /// reports NaN.
+  double residual = 1;
 };
 
 /// Number of lanes of the SIMD path for T under default_isa() (COLLIDE_ISA,

@@ -348,6 +348,71 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
   store_group_impulses<V>(impulses, g, r.j, accumulate);
 }
 
+/// The totals of a group's contacts (KernelJob::accumulated), as the passes
+/// before left them.
+template <class V, bool kFriction, class T>
+COLLIDE_LANE_INLINE Accumulated<V> load_accumulated(const AccumulatedView<T>& view, const ContactGroup& g) {
+  Accumulated<V> acc;
+  acc.normal = contact_field<V>(view.normal, g);
+  acc.target = contact_field<V>(view.target, g);
+  if constexpr (kFriction) {
+    acc.friction = {contact_field<V>(view.friction[0], g), contact_field<V>(view.friction[1], g),
+                    contact_field<V>(view.friction[2], g)};
+  } else {
+    acc.friction = {V(0), V(0), V(0)};
+  }
+  return acc;
+}
+
+template <class V, bool kFriction, class T>
+COLLIDE_LANE_INLINE void store_accumulated(const AccumulatedView<T>& view, const ContactGroup& g,
+                                           const Accumulated<V>& acc) {
+  const auto put = [&](const V& value, T* field) COLLIDE_LANE_LAMBDA {
+    if (g.contiguous) {
+      store(value, field + g.first);
+    } else {
+      scatter(value, field, g.index, V(0) == V(0));
+    }
+  };
+  put(acc.normal, view.normal);
+  put(acc.target, view.target);
+  if constexpr (kFriction) {
+    put(acc.friction.x, view.friction[0]);
+    put(acc.friction.y, view.friction[1]);
+    put(acc.friction.z, view.friction[2]);
+  }
+}
+
+/// One accumulated pass of one group of V::size() contacts (KernelJob::
+/// accumulates): the first pass's law recording the totals, or a later
+/// pass moving them; J is written, not added.
+template <class M, class V, bool kFriction, class T, class View>
+COLLIDE_LANE_INLINE void accumulate_group(const View& bodies, const KernelJob<T>& job, const ContactGroup& g) {
+  const GroupBodies<V::size()> at = group_bodies<V>(bodies, job.contacts, g);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  load_group_bodies<M, V, T>(bodies, at, a, b);
+  const ContactView<T>& contacts = job.contacts;
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
+  Accumulated<V> acc;
+  ContactResult<V> r;
+  if (job.first_pass) {
+    r = first_accumulated_pass<M, V, kFriction>(a, b, c, acc);
+  } else {
+    acc = load_accumulated<V, kFriction>(job.accumulated, g);
+    r = accumulated_pass<M, V, kFriction>(a, b, c, acc);
+  }
+  store_group_bodies<M, V, T>(bodies, at, a, b);
+  store_group_impulses<V>(job.impulses, g, r.j, false);
+  store_accumulated<V, kFriction>(job.accumulated, g, acc);
+}
+
 template <class V>
 COLLIDE_LANE_INLINE Vec3<V> load3(typename V::value_type* const (&from)[3], std::size_t at) {
   return {load<V>(from[0] + at), load<V>(from[1] + at), load<V>(from[2] + at)};
@@ -391,6 +456,35 @@ COLLIDE_LANE_INLINE void step_group(const View& bodies, const ContactView<T>& co
   canonical_outputs(a, b, r.j);  // as resolve_contacts
   store_group_bodies<M, V, T>(bodies, at, a, b);
   store_group_impulses<V>(impulses, g, r.j, accumulate);
+}
+
+/// An accumulated pass of one group of V::size() consecutive contacts at
+/// `first` whose geometry is formed (KernelJob::stepped, frictionless): the
+/// accumulated step on the stored first half, so the bits are those of
+/// accumulate_group.
+template <class M, class V, class T, class View>
+COLLIDE_LANE_INLINE void accumulate_step_group(const View& bodies, const KernelJob<T>& job, std::uint32_t first) {
+  const ContactGroup g{true, first, nullptr};
+  const GroupBodies<V::size()> at = group_bodies<V>(bodies, job.contacts, g);
+  BodyLanes<M, V> a;
+  BodyLanes<M, V> b;
+  load_group_bodies<M, V, T, true>(bodies, at, a, b);
+  const ContactGeometry<V> geo = stored_geometry(job.geometry, first, a, b);
+  const ContactView<T>& contacts = job.contacts;
+  ContactLanes<V> c;
+  c.n = {load<V>(contacts.n.x + first), load<V>(contacts.n.y + first), load<V>(contacts.n.z + first)};
+  c.e = contacts.e ? load<V>(contacts.e + first) : V(contacts.uniform_e);
+  Accumulated<V> acc;
+  ContactResult<V> r;
+  if (job.first_pass) {
+    r = first_accumulated_step<M, V, false>(a, b, c, geo, acc);
+  } else {
+    acc = load_accumulated<V, false>(job.accumulated, g);
+    r = accumulated_step<M, V, false>(a, b, c, geo, acc);
+  }
+  store_group_bodies<M, V, T>(bodies, at, a, b);
+  store_group_impulses<V>(job.impulses, g, r.j, false);
+  store_accumulated<V, false>(job.accumulated, g, acc);
 }
 
 /// Contacts [begin, end) of the schedule's order, all inside one batch, in
@@ -700,6 +794,38 @@ COLLIDE_KERNEL_LOOP std::size_t step_loop(const KernelJob<T>& job, [[maybe_unuse
   return i;
 }
 
+/// GroupLoops::accumulate: an accumulated pass on groups of V::size()
+/// contacts.
+template <class M, class V, bool kFriction, bool kPacked, class T = typename V::value_type>
+COLLIDE_KERNEL_LOOP std::size_t accumulate_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
+                                                std::size_t end) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked && job.friction == kFriction);
+  assert(job.accumulates() && !job.accurate && !job.stepped && !job.accumulate);
+  constexpr std::size_t W = V::size();
+  const auto& bodies = bodies_of<M, kPacked>(job);
+  std::size_t i = begin;
+  for (; i + W <= end; i += W) {
+    accumulate_group<M, V, kFriction, T>(bodies, job, ContactGroup{contiguous, job.order[i], job.order + i});
+  }
+  return i;
+}
+
+/// GroupLoops::accumulate_step: an accumulated pass of the job's contacts
+/// [begin, end), consecutive, whose geometry is formed (KernelJob::stepped:
+/// fast mode, frictionless), in groups of V::size().
+template <class M, class V, bool kPacked, class T = typename V::value_type>
+COLLIDE_KERNEL_LOOP std::size_t accumulate_step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous,
+                                                     std::size_t begin, std::size_t end) {
+  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.accumulates() && job.stepped && !job.accurate && !job.friction && !job.accumulate);
+  assert(begin == end || job.order[begin] == begin);
+  constexpr std::size_t W = V::size();
+  const auto& bodies = bodies_of<M, kPacked>(job);
+  std::size_t i = begin;
+  for (; i + W <= end; i += W) accumulate_step_group<M, V, T>(bodies, job, static_cast<std::uint32_t>(i));
+  return i;
+}
+
 /// KernelLoops::run: a run of the job in pieces (solve_run_pieces), its
 /// geometry in the lanes of this ISA.
 template <class M, class T, bool kPacked>
@@ -740,6 +866,19 @@ void add_solve_loops(GroupLoops<typename V::value_type>& loops) {
   slots[1][1] = &solve_loop<M, V, Mode, true, true>;
 }
 
+/// Model M's accumulated-pass slots of `loops`, in lanes V: with and without
+/// friction, on both layouts.
+template <class M, class V>
+void add_accumulate_loops(GroupLoops<typename V::value_type>& loops) {
+  auto& slots = loops.accumulate[kModelSlot<M>];
+  slots[0][0] = &accumulate_loop<M, V, false, false>;
+  slots[0][1] = &accumulate_loop<M, V, false, true>;
+  slots[1][0] = &accumulate_loop<M, V, true, false>;
+  slots[1][1] = &accumulate_loop<M, V, true, true>;
+  loops.accumulate_step[kModelSlot<M>][0] = &accumulate_step_loop<M, V, false>;
+  loops.accumulate_step[kModelSlot<M>][1] = &accumulate_step_loop<M, V, true>;
+}
+
 /// Model M's velocity-step slots of `loops`, in lanes V, on both layouts.
 template <class M, class V>
 void add_step_loops(GroupLoops<typename V::value_type>& loops) {
@@ -756,6 +895,7 @@ void add_unit_loops(KernelLoops<T>& loops) {
   if constexpr (std::is_same_v<Mode, FastMode>) {
     constexpr std::size_t m = kModelSlot<M>;
     add_step_loops<M, SimdLanes<T>>(loops.groups);
+    add_accumulate_loops<M, SimdLanes<T>>(loops.groups);
     loops.run[m][0] = &run_loop<M, T, false>;
     loops.run[m][1] = &run_loop<M, T, true>;
     loops.geometry[m][0] = &geometry_loop<M, T, false>;
@@ -771,6 +911,7 @@ void add_one_lane_loops(GroupLoops<T>& loops) {
   add_solve_loops<M, ScalarLanes<T>, FastMode>(loops);
   add_solve_loops<M, ScalarLanes<T>, AccurateMode>(loops);
   add_step_loops<M, ScalarLanes<T>>(loops);
+  add_accumulate_loops<M, ScalarLanes<T>>(loops);
 }
 
 }  // namespace

@@ -120,7 +120,7 @@ def _options(model, sample=0, **solve):
     """The options of the tasks: ``model``, ``sample``, ``threads`` (the
     task's share of the machine, _tasks.on_its_threads) and ``solve``, the
     keywords every task passes to collide.solve (accuracy, order, passes,
-    threads, isa), checked and normalised by the library as collide.solve
+    iteration, threads, isa), checked and normalised by the library as collide.solve
     checks them, with its messages (the ISA's name only: the workers' CPUs
     decide whether they have it)."""
     if model not in ("auto", "rigid", "sphere", "particle"):
@@ -233,8 +233,8 @@ def _is_scene_files(scene):
         isinstance(x, (str, os.PathLike)) for x in scene)
 
 
-def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", order="input", passes=1, dtype=None,
-          threads=1, isa=None, out_dir=None, workers=None, progress=False):
+def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", order="input", passes=1,
+          iteration="repeat", dtype=None, threads=1, isa=None, out_dir=None, workers=None, progress=False):
     """Solves one scene on Dask workers, island by island; the same bytes as
     :func:`collide.solve` on one machine. Returns a :class:`Solution` ``(J,
     v, w, stats)``.
@@ -258,7 +258,8 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     the grouping never changes the result. Each partition runs
     :func:`collide.solve` with the model chosen for the whole scene
     (``model``: "auto", "rigid", "sphere", "particle"), ``accuracy``
-    ("fast" or "accurate"), ``passes``, ``threads`` solver threads per task
+    ("fast" or "accurate"), ``passes``, ``iteration`` ("repeat" or
+    "accumulate"), ``threads`` solver threads per task
     (default 1: one per Dask thread) and ``isa``, in the whole scene's
     ``order`` ("input" or "colour": for the colour order the client finds
     the scene's solve order and each partition solves its contacts in it).
@@ -275,7 +276,8 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     warns with :class:`IslandWarning` when the largest island holds more than
     ``GIANT_ISLAND_SHARE`` of the contacts. ``stats``: collisions, bodies,
     islands, largest_island, largest_island_share, partitions (their contact
-    counts), model, precision, accuracy, order, passes, call_seconds (the
+    counts), model, precision, accuracy, order, passes, iteration,
+    call_seconds (the
     whole call, wall time), kernel_seconds (the partitions' solves, summed),
     collisions_per_second (collisions / kernel_seconds: the kernels'
     throughput, as collide.solve reports it), allocate_seconds (the allocate
@@ -285,7 +287,8 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     its worker, read to write), islands_seconds, and for files read_seconds
     (the load and check on the client) and outputs (the three paths)."""
     started = time.perf_counter()
-    options = _options(model, accuracy=accuracy, order=order, passes=passes, threads=threads, isa=isa)
+    options = _options(model, accuracy=accuracy, order=order, passes=passes, iteration=iteration, threads=threads,
+                       isa=isa)
     if _is_scene_files(scene):
         if out_dir is None:
             raise ValueError("collide.dask.solve: scene files need out_dir, where the workers write J, v and w")
@@ -314,7 +317,8 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
     return {"collisions": collisions, "bodies": body_count, **figures, "partitions": [int(c) for c in counts if c],
             "model": scene_model, "precision": "float" if precision == np.float32 else "double",
             "accuracy": options["solve"]["accuracy"], "order": options["solve"]["order"],
-            "passes": options["solve"]["passes"], "call_seconds": time.perf_counter() - started,
+            "passes": options["solve"]["passes"], "iteration": options["solve"]["iteration"],
+            "call_seconds": time.perf_counter() - started,
             "kernel_seconds": kernel_seconds,
             "collisions_per_second": collisions / kernel_seconds if kernel_seconds > 0 else 0.0,
             "allocate_seconds": sum(r["allocate_seconds"] for r in results),
@@ -465,8 +469,8 @@ def _entry(i, item):
     return entry
 
 
-def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="input", passes=1, sample=10_000,
-                 threads=1, isa=None, workers=None, progress=False):
+def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="input", passes=1,
+                 iteration="repeat", sample=10_000, threads=1, isa=None, workers=None, progress=False):
     """Solves many scenes, one task each, and measures each against the
     reference; returns a pandas DataFrame, one row per scene in the order
     given, columns ``SCENE_COLUMNS``: scene (its name), model (the one that
@@ -484,7 +488,7 @@ def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="i
     "model", "friction", "shuffle", "dtype", "name", "accuracy"), generated
     on the worker, so nothing is stored. Each scene is solved whole by
     :func:`collide.solve` with ``model``, ``accuracy``, ``order``,
-    ``passes``, ``threads`` (solver threads per task) and ``isa``; the
+    ``passes``, ``iteration``, ``threads`` (solver threads per task) and ``isa``; the
     sample is the scene's first ``sample`` contacts, as ``collide report``
     samples, solved alone with the same options and compared with
     :func:`collide.reference_solve` replaying them. In input order with one
@@ -497,7 +501,8 @@ def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="i
     entry); a scene file that is bad raises the reader's error (file, row,
     column)."""
     pandas = _need("pandas")
-    options = _options(model, sample, accuracy=accuracy, order=order, passes=passes, threads=threads, isa=isa)
+    options = _options(model, sample, accuracy=accuracy, order=order, passes=passes, iteration=iteration,
+                       threads=threads, isa=isa)
     if options["sample"] < 0:
         raise ValueError(f"sample must be >= 0, got {sample}")
     entries = [_entry(i, item) for i, item in enumerate(scenes)]

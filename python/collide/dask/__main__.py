@@ -41,6 +41,8 @@ def _parser():
     common.add_argument("--order", default="input", choices=("input", "colour"),
                         help="the solve order, as collide.solve's order= (default input)")
     common.add_argument("--passes", type=int, default=1, help="passes over the contacts in that order (default 1)")
+    common.add_argument("--iteration", default="repeat", choices=("repeat", "accumulate"),
+                        help="what the passes after the first do, as collide.solve's iteration= (default repeat)")
     common.add_argument("--threads", type=int, default=1, help="solver threads per task (default 1)")
     common.add_argument("--isa", default=None, choices=("sse2", "avx2", "avx512"))
     common.add_argument("--no-progress", action="store_true", help="no progress on stderr")
@@ -104,7 +106,7 @@ def _write_atomically(path, text):
 
 def _solve_options(args):
     """The options both subcommands pass on as collide.solve's keywords."""
-    return {k: getattr(args, k) for k in ("model", "accuracy", "order", "passes", "threads", "isa")}
+    return {k: getattr(args, k) for k in ("model", "accuracy", "order", "passes", "iteration", "threads", "isa")}
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):

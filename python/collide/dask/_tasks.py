@@ -226,7 +226,8 @@ def scene_row(entry, options):
     k = min(options["sample"], len(contacts))
     sample_bodies, sample_contacts, _ = sub_scene(bodies, contacts, np.arange(k))
     J, stats = collide.solve(bodies, contacts, model=options["model"], **solve)
-    ref = collide.reference_solve(sample_bodies, sample_contacts, order=solve["order"], passes=solve["passes"])
+    ref = collide.reference_solve(sample_bodies, sample_contacts, order=solve["order"], passes=solve["passes"],
+                                  iteration=solve["iteration"])
     J_sample, _ = collide.solve(sample_bodies, sample_contacts, model=stats["model"], **solve)
     alone_is_whole = solve["order"] == "input" and solve["passes"] == 1
     if alone_is_whole and J_sample.tobytes() != np.ascontiguousarray(J[:, :k]).tobytes():

@@ -15,6 +15,7 @@
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/iteration.hpp"
 
 namespace collide {
 
@@ -53,11 +54,13 @@ struct ReferenceContact {
 
 /// The sequence in which a solve applies the law: the contacts in `order`
 /// (contact indices, each once: a solve's Schedule::order()), or in input
-/// order when it is null; `passes` times over, J summed over the passes
-/// (SolverOptions::passes).
+/// order when it is null; `passes` times over (SolverOptions::passes), J
+/// summed over the passes or, with Iteration::accumulate, the totals the
+/// passes accumulated (SolverOptions::iteration).
 struct SolveSequence {
   const std::uint32_t* order = nullptr;
   std::size_t passes = 1;
+  Iteration iteration = Iteration::repeat;
 };
 
 /// Applies the law to every contact in `sequence` (input order by default).
