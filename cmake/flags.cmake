@@ -5,10 +5,13 @@
 #                            links (PRIVATE, and only in the build: it is never
 #                            installed or exported): the floating-point policy
 #                            and the warnings
-#   COLLIDE_ISA_FLAGS_<isa>  the flags of one kernel ISA (sse2, avx2, avx512),
-#                            for the per-ISA kernel objects (core/) and the
-#                            per-ISA tests of the lane layer (tests/)
-#   COLLIDE_KERNEL_ALIGN_FLAGS  the code alignment of every kernel object
+#   collide_isa_<isa>        an INTERFACE target per kernel ISA (sse2, avx2,
+#                            avx512; native elsewhere) with that ISA's flags,
+#                            linked by the per-ISA kernel objects (core/) and
+#                            the per-ISA tests of the lane layer (tests/)
+#   collide_kernel_placement an INTERFACE target with the code alignment of
+#                            every kernel object
+# All of them are build-only: no installed or exported target links them.
 #
 # Everything outside the per-ISA kernels is compiled for the target's
 # baseline: no -march=native anywhere.
@@ -26,13 +29,13 @@ set(COLLIDE_FP_FLAGS -ffp-contract=off -fno-fast-math)
 
 add_library(collide_build_flags INTERFACE)
 target_compile_options(collide_build_flags INTERFACE ${COLLIDE_FP_FLAGS} -Wall -Wextra -Wpedantic)
-# In unity batches (COLLIDE_UNITY_BUILD, cmake/options.cmake) each source is
+# In unity batches (CMAKE_UNITY_BUILD, cmake/options.cmake) each source is
 # included into a batch file, so GCC's -Wsubobject-linkage, which is meant
 # for headers, reports every lambda of a source that captures a type of the
 # source's anonymous namespace. A source is included once, so no such type
 # can meet its namesake; the per-source build keeps the warning and shows
 # one that would be real.
-if(COLLIDE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+if(CMAKE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   target_compile_options(collide_build_flags INTERFACE -Wno-subobject-linkage)
 endif()
 
@@ -42,16 +45,28 @@ endif()
 # policy above): the ISA changes speed, never answers.
 # ---------------------------------------------------------------------------
 if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
-  set(COLLIDE_ISA_FLAGS_sse2 -msse2)
+  add_library(collide_isa_sse2 INTERFACE)
+  target_compile_options(collide_isa_sse2 INTERFACE -msse2)
   # -mno-fma on AVX2, on purpose: no fused multiply-add instruction exists
   # there to appear.
-  set(COLLIDE_ISA_FLAGS_avx2 -mavx2 -mno-fma)
+  add_library(collide_isa_avx2 INTERFACE)
+  target_compile_options(collide_isa_avx2 INTERFACE -mavx2 -mno-fma)
   # No -mno-fma here: AVX-512F includes FMA, and clang drops AVX-512 altogether
   # under -mno-fma (its 16-lane "AVX-512" object was then AVX2 code). No FMA
   # can appear anyway: -ffp-contract=off forbids contraction and the code
   # never calls an fma. -mprefer-vector-width=512: clang would otherwise split
   # 16-lane vectors into two ymm halves.
-  set(COLLIDE_ISA_FLAGS_avx512 -mavx512f -mavx512bw -mavx512dq -mavx512vl -mprefer-vector-width=512)
+  add_library(collide_isa_avx512 INTERFACE)
+  target_compile_options(collide_isa_avx512 INTERFACE -mavx512f -mavx512bw -mavx512dq -mavx512vl
+                                                      -mprefer-vector-width=512)
+  # GCC 12's _mm512_sqrt_ps starts from _mm512_undefined_ps(), a deliberate
+  # self-initialisation that -W(maybe-)uninitialized reports once inlined.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(collide_isa_avx512 INTERFACE -Wno-maybe-uninitialized -Wno-uninitialized)
+  endif()
+else()
+  # One kernel for the target's own lanes, compiled for the target's baseline.
+  add_library(collide_isa_native INTERFACE)
 endif()
 
 # ---------------------------------------------------------------------------
@@ -68,4 +83,5 @@ endif()
 # AVX-512 rigid float fast unit's). Clang 14 accepts both flags too (the
 # sanitizer build).
 # ---------------------------------------------------------------------------
-set(COLLIDE_KERNEL_ALIGN_FLAGS -falign-functions=64 -falign-loops=64)
+add_library(collide_kernel_placement INTERFACE)
+target_compile_options(collide_kernel_placement INTERFACE -falign-functions=64 -falign-loops=64)

@@ -104,15 +104,16 @@ option(COLLIDE_BUILD_CLI "Build the collide command-line tool" ${_collide_tools_
 option(COLLIDE_BUILD_PYTHON "Build the Python extension (needs pybind11)" ${_collide_tools_default})
 option(COLLIDE_BUILD_EXAMPLES "Build the examples" ${_collide_tools_default})
 option(COLLIDE_BUILD_FUZZ "Build the libFuzzer targets (needs clang)" OFF)
-# Unity batches (CMake's UNITY_BUILD, 8 sources a batch) for the libraries and
-# the tool: their ~60 sources parse the same standard and TBB headers, and in
-# batches they compile in about two fifths of the compiler time (the kernel
-# objects, one source each, are as they were). For a build that only runs the tool
-# (scripts/build.sh --tool, README command 1). Off by default: a per-source
-# build keeps compile_commands.json per source for clang-tidy and rebuilds
-# one source per edit. scripts/ci-sanitizers.sh builds with it on, so a name
-# that two sources of a batch define twice fails CI.
-option(COLLIDE_UNITY_BUILD "Compile the libraries and the collide tool in unity batches (faster from scratch)" OFF)
+# Unity batches are CMake's own: -DCMAKE_UNITY_BUILD=ON (UNITY_BUILD of every
+# target, 8 sources a batch; the kernel objects, one source each, and the
+# tests stay out: core/CMakeLists.txt, tests/CMakeLists.txt). The libraries'
+# and the tool's sources parse the same standard and TBB headers, so in
+# batches they compile in much less compiler time, which suits a build that
+# only runs the tool (the `tool` preset of CMakePresets.json: scripts/build.sh
+# --tool, README command 1). Off by default: a per-source build keeps
+# compile_commands.json per source for clang-tidy and rebuilds one source per
+# edit. The `asan` preset (scripts/ci-sanitizers.sh) builds with it on, so a
+# name that two sources of a batch define twice fails CI.
 foreach(tool TESTS BENCH CLI PYTHON)
   if(COLLIDE_BUILD_${tool} AND NOT COLLIDE_BUILD_EVAL)
     message(FATAL_ERROR "COLLIDE_BUILD_${tool} needs the io and eval libraries (COLLIDE_BUILD_IO and COLLIDE_BUILD_EVAL ON)")

@@ -2,26 +2,26 @@
 # Configures and builds collide (Release) into build/, after installing what is missing.
 #   scripts/build.sh [--target T]... [CMAKE_OPTION]...
 #       everything (libraries, tool, tests, benchmarks, Python, examples), or
-#       only the targets named; README command 2
+#       only the targets named: the `release` preset of CMakePresets.json;
+#       README command 2
 #   scripts/build.sh --tool [CMAKE_OPTION]...
 #       the `collide` tool alone, with only its packages (install-deps.sh
 #       --tool) and the tests, benchmarks, Python and examples configured
 #       off, so none of their packages is needed, and its sources compiled
-#       in unity batches (COLLIDE_UNITY_BUILD); README command 1
-# Other arguments go to the configure step after the script's own options,
-# so they win. Either way every part is named ON or OFF, so a build/ that
-# one configured is reconfigured by the other.
+#       in unity batches (CMAKE_UNITY_BUILD): the `tool` preset; README
+#       command 1
+# Other arguments go to the configure step after the preset, so they win.
+# Either preset names every part ON or OFF, so a build/ that one configured
+# is reconfigured by the other.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-state=ON
-unity=OFF
+preset=release
 deps=()
 targets=()
 configure=()
 while [ $# -gt 0 ]; do
   if [ "$1" = --tool ]; then
-    state=OFF
-    unity=ON
+    preset=tool
     deps=(--tool)
     targets=(--target collide_cli)
     shift
@@ -34,8 +34,6 @@ while [ $# -gt 0 ]; do
   fi
 done
 "$root/scripts/install-deps.sh" "${deps[@]}"
-options=(-DCOLLIDE_BUILD_CLI=ON -DCOLLIDE_UNITY_BUILD=$unity)
-for part in TESTS BENCH PYTHON EXAMPLES; do options+=("-DCOLLIDE_BUILD_$part=$state"); done
 # With ccache, paths hashed relative to the build directory (CCACHE_BASEDIR),
 # so that the pip install test (setup.py, same layout) reuses these objects.
 launcher=()
@@ -43,5 +41,6 @@ if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
 fi
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" "${options[@]}" "${configure[@]}" >/dev/null
-cmake --build "$root/build" -j"$(nproc)" "${targets[@]}"
+cmake -S "$root" --preset "$preset" "${launcher[@]}" "${configure[@]}" >/dev/null
+# A build preset is read from the source directory's CMakePresets.json.
+(cd "$root" && cmake --build --preset "$preset" -j"$(nproc)" "${targets[@]}")

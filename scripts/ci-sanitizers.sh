@@ -19,7 +19,7 @@
 #      one-lane kernel of every path): the kernel is one body over the lane
 #      type (core/src/kernel/loops.hpp), so a wider copy adds minutes of compile time
 #      and no code of its own, and the Release stage runs every ISA's. The
-#      libraries and the tool compile in unity batches (COLLIDE_UNITY_BUILD,
+#      libraries and the tool compile in unity batches (CMAKE_UNITY_BUILD,
 #      as README command 1 builds them), so two sources of a batch that
 #      define one name fail here.
 #   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 45),
@@ -37,14 +37,22 @@
 #      must produce a TSan report in the kernel: proof that the bridge and the
 #      suppressions cannot hide a race on the kernel's data.
 #
-# Build directories: build-asan/ and build-tsan/ next to build/.
+# The configurations, builds and test runs are the `asan` and `tsan` presets
+# of CMakePresets.json (Clang 14); build directories: build-asan/ and
+# build-tsan/ next to build/.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install-deps.sh"
+# The presets are read from the source directory's CMakePresets.json.
+cd "$root"
 
 jobs="$(nproc)"
 fuzz_seconds="${FUZZ_SECONDS:-45}"
-cxx="$(command -v clang++-14 || command -v clang++)"
+# The presets' compiler is clang++-14; where only another clang++ exists, that one.
+compiler=()
+if ! command -v clang++-14 >/dev/null; then
+  compiler=(-DCMAKE_CXX_COMPILER="$(command -v clang++)")
+fi
 # Through ccache when present, as scripts/build.sh does: a re-run after a
 # change recompiles only what changed.
 launcher=()
@@ -57,14 +65,13 @@ stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
 # --- 1. ASan + UBSan --------------------------------------------------------
 asan="$root/build-asan"
 stage "ASan+UBSan build"
-cmake -S "$root" -B "$asan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" \
-  -DCOLLIDE_SANITIZE=address,undefined -DCOLLIDE_BUILD_FUZZ=ON -DCOLLIDE_KERNEL_ISAS=sse2 -DCOLLIDE_UNITY_BUILD=ON \
-  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
-cmake --build "$asan" -j"$jobs"
+cmake --preset asan "${compiler[@]}" "${launcher[@]}" >/dev/null
+cmake --build --preset asan -j"$jobs"
 stage "ASan+UBSan tests"
+# The sanitizer options of the `asan` test preset, for the fuzzers too.
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
-ctest --test-dir "$asan" --output-on-failure -j"$jobs" -LE "package|objects|report"
+ctest --preset asan -j"$jobs"
 
 # --- 2. Fuzzing -------------------------------------------------------------
 stage "fuzzing, ${fuzz_seconds}s per target"
@@ -94,17 +101,15 @@ done
 # --- 3. TSan on the parallel kernel -------------------------------------------
 tsan="$root/build-tsan"
 stage "TSan build"
-cmake -S "$root" -B "$tsan" -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug "${launcher[@]}" -DCOLLIDE_SANITIZE=thread \
-  -DCOLLIDE_KERNEL_ISAS=sse2 \
-  -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCOLLIDE_BUILD_CLI=OFF -DCOLLIDE_BUILD_PYTHON=OFF >/dev/null
-cmake --build "$tsan" -j"$jobs" --target test_determinism test_schedule test_islands test_solver_arena \
-  test_hard_shared collide_itt_tsan collide_race_canary
+cmake --preset tsan "${compiler[@]}" "${launcher[@]}" >/dev/null
+# The build preset's targets: the tests below and the race detector's helpers.
+cmake --build --preset tsan -j"$jobs"
 stage "TSan tests"
+# The environment of the `tsan` test preset, for the canary too.
 export INTEL_LIBITTNOTIFY64="$tsan/libcollide_itt_tsan.so"
 export INTEL_ITTNOTIFY_GROUPS=sync
 export TSAN_OPTIONS="suppressions=$root/tests/tsan/tbb.supp"
-ctest --test-dir "$tsan" --output-on-failure -j"$jobs" \
-  -R '^(Scenes/Determinism|Schedule|ScheduleOrder|Islands|AllModels/IslandSolves|SolverArena|HardShared)\.'
+ctest --preset tsan -j"$jobs"
 # The negative control: TSan must see the canary's race, in the kernel.
 set +e
 "$tsan/collide_race_canary" >"$tsan/race_canary.log" 2>&1

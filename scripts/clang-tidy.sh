@@ -6,8 +6,10 @@
 #   scripts/clang-tidy.sh [-p BUILD] --changed [BASE] the C++ files a change
 #                                                     touches against BASE
 #
-# BUILD is a configured build directory (default build/: scripts/build.sh, or
-# `cmake -S . -B build`); its compile_commands.json gives each file's flags.
+# BUILD is a configured build directory (default build/: scripts/build.sh,
+# or `cmake --preset release`); its compile_commands.json, which every preset
+# of CMakePresets.json writes (CMAKE_EXPORT_COMPILE_COMMANDS), gives each
+# file's flags.
 # With --changed, BASE defaults to $COLLIDE_TIDY_BASE, else to where HEAD left
 # the branch main (git merge-base main HEAD), else, on main itself, to HEAD~1;
 # the change is BASE against the working tree, added and modified files only.
@@ -36,7 +38,7 @@ while [ $# -gt 0 ]; do
       if [ $# -gt 0 ] && [ "${1#-}" = "$1" ] && git rev-parse --verify -q "$1^{commit}" >/dev/null; then
         base="$1"; shift
       fi ;;
-    -h|--help) sed -n '2,22p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,24p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "clang-tidy.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
     *) files+=("$1"); shift ;;
   esac
@@ -48,7 +50,7 @@ if [ -z "$tidy" ]; then
   exit 2
 fi
 if [ ! -f "$build/compile_commands.json" ]; then
-  echo "clang-tidy.sh: $build/compile_commands.json not found: configure first (cmake -S . -B build)" >&2
+  echo "clang-tidy.sh: $build/compile_commands.json not found: configure first (cmake --preset release, or -DCMAKE_EXPORT_COMPILE_COMMANDS=ON)" >&2
   exit 2
 fi
 

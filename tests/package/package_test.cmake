@@ -196,18 +196,20 @@ elseif(MODE STREQUAL "add_subdirectory")
   pkg_config_consumer(${shared_prefix} SHARED_LIBRARY ${WORK_DIR}/shared_pkg_config collide)
 
 elseif(MODE STREQUAL "tool_configure")
-  # README command 1 (scripts/build.sh --tool) installs only the tool's
-  # packages (scripts/install-deps.sh --tool) and configures the tests, the
+  # README command 1 (scripts/build.sh --tool: the `tool` preset of
+  # CMakePresets.json) installs only the tool's packages
+  # (scripts/install-deps.sh --tool) and configures the tests, the
   # benchmarks, Python and the examples off: that configuration must find
-  # none of the other packages. Configured only (the tool's objects are the
-  # main build's), with every other package made unfindable.
+  # none of the other packages. The preset itself, configured only (the
+  # tool's objects are the main build's) in a directory of its own, with
+  # every other package made unfindable.
   set(dir ${WORK_DIR}/tool_configure)
   fresh_dir(${dir})
-  run("configure the tool alone" COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${dir} -G ${GENERATOR}
-      -DCMAKE_BUILD_TYPE=Release -DCOLLIDE_BUILD_CLI=ON -DCOLLIDE_UNITY_BUILD=ON -DCOLLIDE_BUILD_TESTS=OFF
-      -DCOLLIDE_BUILD_BENCH=OFF -DCOLLIDE_BUILD_PYTHON=OFF -DCOLLIDE_BUILD_EXAMPLES=OFF -DCMAKE_DISABLE_FIND_PACKAGE_GTest=ON
-      -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=ON -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON
-      -DCMAKE_DISABLE_FIND_PACKAGE_pybind11=ON -DCMAKE_DISABLE_FIND_PACKAGE_Python3=ON)
+  run("configure the tool alone" WORKING_DIRECTORY ${SOURCE_DIR}
+      COMMAND ${CMAKE_COMMAND} --preset tool -S ${SOURCE_DIR} -B ${dir} -G ${GENERATOR}
+      -DCMAKE_DISABLE_FIND_PACKAGE_GTest=ON -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=ON
+      -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON -DCMAKE_DISABLE_FIND_PACKAGE_pybind11=ON
+      -DCMAKE_DISABLE_FIND_PACKAGE_Python3=ON)
   # ... and it still has the tool to build.
   run("the tool's target" COMMAND ${CMAKE_COMMAND} --build ${dir} --target help)
   if(NOT last_output MATCHES "collide_cli")
