@@ -170,15 +170,17 @@ def test_reference_and_impulse_error_match_check(cli, workdir):
     assert collide.impulse_error(bad, ref)[k] > 500
 
 
+@pytest.mark.parametrize("iteration", ["repeat", "accumulate"])
 @pytest.mark.parametrize("order", ["input", "colour"])
 @pytest.mark.parametrize("passes", [1, 4, 16])
 @pytest.mark.parametrize("kind,n,friction", [("pile", 12, False), ("pile", 12, True), ("debris", 20000, True)])
-def test_error_bound_can_fail_at_every_pass_count(kind, n, friction, order, passes):
+def test_error_bound_can_fail_at_every_pass_count(kind, n, friction, order, passes, iteration):
     # docs/python.md's assert, on the solve and on a J that is 1% too large
     # or all zero (docs/collision-law.md, "The error bound over passes").
     bodies, contacts = collide.generate(kind, n, friction=friction, seed=7)
-    ref = collide.reference_solve(bodies, contacts, order=order, passes=passes)
-    J, _ = collide.solve(bodies, contacts, order=order, passes=passes)
+    ref = collide.reference_solve(bodies, contacts, order=order, passes=passes, iteration=iteration)
+    J, stats = collide.solve(bodies, contacts, order=order, passes=passes, iteration=iteration)
+    assert stats["iteration"] == iteration
     assert collide.impulse_error(J, ref).max() <= collide.error_bound_eps
     assert collide.impulse_error(J * np.float32(1.01), ref).max() > collide.error_bound_eps
     assert collide.impulse_error(np.zeros_like(J), ref).max() > collide.error_bound_eps
@@ -314,3 +316,31 @@ def test_generate_pile(dtype):
         collide.generate("pile", 0)
     with pytest.raises(ValueError, match="shuffle"):
         collide.generate("pairs", 10, shuffle=True)
+
+
+def test_accumulated_passes_as_the_tool_runs_them(cli, workdir):
+    # collide.solve(iteration="accumulate") and `collide solve --iteration
+    # accumulate` give the same bytes, and the same residual.
+    run([cli, "gen", "--pile", "9", "--friction", "--out", workdir, "--seed", "3"])
+    b_csv, c_csv = os.path.join(workdir, "bodies.csv"), os.path.join(workdir, "contacts.csv")
+    ob, oj = os.path.join(workdir, "out_bodies.csv"), os.path.join(workdir, "out_j.csv")
+    r = run([cli, "solve", "--bodies", b_csv, "--contacts", c_csv, "--out-bodies", ob, "--out-impulses", oj,
+             "--precision", "double", "--order", "colour", "--passes", "6", "--iteration", "accumulate", "--stats",
+             "--check"])
+    cli_stats = json.loads(r.stderr.strip().splitlines()[-1])
+    bodies, contacts = collide.read_scene(b_csv, c_csv, dtype=np.float64)
+    J, stats = collide.solve(bodies, contacts, order="colour", passes=6, iteration="accumulate")
+    np.testing.assert_array_equal(J.view(np.uint64), read_impulses(oj, np.float64).view(np.uint64))
+    assert (cli_stats["iteration"], stats["iteration"]) == ("accumulate", "accumulate")
+    # The tool's JSON prints ten significant digits.
+    assert cli_stats["residual"] == pytest.approx(stats["residual"], rel=1e-9) and 0 < stats["residual"] < 1
+    assert cli_stats["check_passed"]
+
+
+def test_the_accurate_mode_takes_repeated_passes():
+    bodies, contacts = collide.generate("pile", 3)
+    with pytest.raises(ValueError, match="iteration='accumulate' runs in the fast mode"):
+        collide.solve(bodies, contacts, accuracy="accurate", iteration="accumulate")
+    with pytest.raises(ValueError, match="unknown iteration 'sum' \\(expected repeat or accumulate\\)"):
+        collide.solve(bodies, contacts, iteration="sum")
+    assert repr(collide.Solver(iteration="accumulate")).endswith("iteration='accumulate')")
