@@ -121,7 +121,8 @@ class CliTest : public ::testing::Test {
   }
 
   /// Writes the scene files and runs solve on them with `extra` options.
-  RunResult solve(const std::string& bodies, const std::string& contacts, std::vector<std::string> extra = {}) const {
+  RunResult solve(const std::string& bodies, const std::string& contacts,
+                  const std::vector<std::string>& extra = {}) const {
     spit(path("bodies.csv"), bodies);
     spit(path("contacts.csv"), contacts);
     return run(solve_args(extra));
