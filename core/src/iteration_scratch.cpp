@@ -16,7 +16,7 @@ namespace collide::detail {
 namespace {
 
 /// Contacts per task: long stretches that stream.
-constexpr std::size_t kGrain = 16384;
+constexpr std::size_t kContactsPerTask = 16384;
 
 struct Largest {
   double change = 0;  ///< largest |J - J saved|
@@ -62,7 +62,7 @@ void IterationScratch<T>::save(tbb::task_arena& arena, const ImpulseView<T>& imp
   assert(saved_[0].size() >= impulses.count);
   arena.execute([&] {
     tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, impulses.count, kGrain),
+        tbb::blocked_range<std::size_t>(0, impulses.count, kContactsPerTask),
         [&](const tbb::blocked_range<std::size_t>& r) {
           std::copy(impulses.j.x + r.begin(), impulses.j.x + r.end(), saved_[0].data() + r.begin());
           std::copy(impulses.j.y + r.begin(), impulses.j.y + r.end(), saved_[1].data() + r.begin());
@@ -76,7 +76,7 @@ template <class T>
 double IterationScratch<T>::residual(tbb::task_arena& arena, const ImpulseView<T>& impulses) const {
   const Largest largest = arena.execute([&] {
     return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, impulses.count, kGrain), Largest{},
+        tbb::blocked_range<std::size_t>(0, impulses.count, kContactsPerTask), Largest{},
         [&](const tbb::blocked_range<std::size_t>& r, Largest m) {
           for (std::size_t k = r.begin(); k < r.end(); ++k) {
             const double x = impulses.j.x[k];
