@@ -3,8 +3,9 @@ the same bytes as collide.solve, scenes given as arrays or as binary scene
 files, both orders with one pass and several (the colour order through the
 whole scene's solve order), collide.solve's errors for bad options, the
 partitions, the giant-island warning, solve_scenes' table, the
-command, bad input, a worker killed mid-run, and `import collide` without
-Dask.
+command, bad input, a worker killed mid-run, the warm start (arrays, files,
+solve_scenes and the command, the same bytes as collide.solve(warm=), bad
+ones refused with its messages), and `import collide` without Dask.
 
 The cluster is started once for the module. Dask, distributed and pandas are
 required (scripts/install-deps.sh installs them): without them the fixture
@@ -650,6 +651,271 @@ def test_a_worker_killed_mid_run_gives_the_same_bytes(client, tmp_path, files):
     assert os.path.exists(marker), "a worker was killed during the run"
     same_bytes(solution, expected)
     client.wait_for_workers(2, timeout=60)
+
+
+# ---------------------------------------------------------------------------
+# The warm start: warm= of collide.solve, across the workers.
+# ---------------------------------------------------------------------------
+
+
+def warm_frame(kind="piles", dtype=np.float32, order="input"):
+    """A scene and a warm start for it: four piles of 6^3 boxes on one
+    ground (four islands, 2304 contacts) or 2000 independent pairs, and the
+    J of six accumulated passes of a solve of it before (on a copy)."""
+    if kind == "piles":
+        bodies, contacts = piles_scene(dtype, seed=3, piles=4, n=6)
+    else:
+        bodies, contacts = collide.generate("pairs", 2000, friction=True, seed=4, dtype=dtype)
+    J0, _ = collide.solve(*copy_scene(bodies, contacts), order=order, passes=6, iteration="accumulate")
+    return bodies, contacts, J0
+
+
+def solved_copy(bodies, contacts, **kwargs):
+    """collide.solve on a copy of the scene: (J, the copy's bodies, stats)."""
+    b, c = copy_scene(bodies, contacts)
+    J, stats = collide.solve(b, c, **kwargs)
+    return J, b, stats
+
+
+def same_bits(solution, J, bodies):
+    """J, v and w of a distributed solve are, bit for bit, collide.solve's."""
+    bits = np.uint32 if J.dtype == np.float32 else np.uint64
+    for got, want in ((solution.J, J), (solution.v, bodies.v), (solution.w, bodies.w)):
+        assert np.asarray(got).dtype == want.dtype
+        assert np.array_equal(np.asarray(got).view(bits), want.view(bits))
+
+
+def save_impulses(path, J):
+    """J as an impulses file (members jx, jy, jz), written by NumPy."""
+    np.savez(path, jx=J[0], jy=J[1], jz=J[2])
+
+
+def read_impulses_npz(path):
+    with np.load(path) as z:
+        return np.stack([z["jx"], z["jy"], z["jz"]])
+
+
+@pytest.mark.parametrize("order", ["input", "colour"])
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_warm_arrays_same_bits_as_collide_solve(client, order, dtype):
+    bodies, contacts, J0 = warm_frame("piles", dtype, order)
+    J, after, stats = solved_copy(bodies, contacts, order=order, passes=2, iteration="accumulate", warm=J0)
+    assert stats["warm_start"]
+    cold, _, _ = solved_copy(bodies, contacts, order=order, passes=2, iteration="accumulate")
+    assert not np.array_equal(cold, J), "the warm start changes the solve"
+    warm = J0.copy()
+    solution = cd.solve((bodies, contacts), client, order=order, passes=2, iteration="accumulate", warm=warm)
+    same_bits(solution, J, after)
+    assert warm.tobytes() == J0.tobytes(), "the warm start is only read"
+    assert solution.stats["warm_start"] is True and solution.stats["iteration"] == "accumulate"
+    assert len(solution.stats["partitions"]) == 2
+    assert cd.solve(copy_scene(bodies, contacts), client).stats["warm_start"] is False
+
+
+@pytest.mark.parametrize("kind, order, start", [
+    ("pairs", "input", "tool"),     # partitions of consecutive rows: the impulses file's columns mapped in place
+    ("piles", "colour", "tool"),    # rows through the order file: the columns gathered
+    ("pairs", "input", "out_dir"),  # out_dir's own J.npy, of the solve before, replaced by this one's
+    ("piles", "colour", "out_dir"),
+])
+def test_warm_files_same_bits_as_collide_solve(client, cli, tmp_path, kind, order, start):
+    bodies, contacts, _ = warm_frame(kind, np.float32, order)
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    out = tmp_path / "out"
+    if start == "tool":
+        warm = str(tmp_path / "j0.npz")
+        run([cli, "solve", "--bodies", bp, "--contacts", cp, "--out-bodies", str(tmp_path / "ob.npz"),
+             "--out-impulses", warm, "--order", order, "--passes", "6", "--iteration", "accumulate"])
+        J0 = read_impulses_npz(warm)
+    else:
+        before = cd.solve((bp, cp), client, out_dir=out, order=order, passes=6, iteration="accumulate", partitions=3)
+        J0 = np.array(before.J)
+        warm = out / "J.npy"
+    J, after, _ = solved_copy(*collide.load(bp, cp), order=order, passes=2, iteration="accumulate", warm=J0)
+    solution = cd.solve((bp, cp), client, out_dir=out, order=order, passes=2, iteration="accumulate", warm=warm,
+                        partitions=3)
+    same_bits(solution, J, after)
+    assert solution.stats["warm_start"] is True
+    assert sorted(os.listdir(out)) == ["J.npy", "v.npy", "w.npy"], "nothing else left behind"
+
+
+def test_a_double_warm_start_file_for_a_float_solve_is_rounded_as_the_tool_rounds_it(client, cli, tmp_path):
+    # `collide solve --precision float --warm-start` of a float64 impulses
+    # file: the same bits, the impulses rounded as scene values are.
+    bodies, contacts, J0 = warm_frame("piles", np.float64, "input")
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    warm = str(tmp_path / "j0.npz")
+    save_impulses(warm, J0)
+    ob, oj = str(tmp_path / "ob.npz"), str(tmp_path / "oj.npz")
+    run([cli, "solve", "--bodies", bp, "--contacts", cp, "--out-bodies", ob, "--out-impulses", oj, "--precision",
+         "float", "--passes", "2", "--iteration", "accumulate", "--warm-start", warm])
+    with np.load(ob) as z:
+        tool = {k: np.stack([z[k + axis] for axis in "xyz"]) for k in "vw"}
+    solution = cd.solve((bp, cp), client, out_dir=tmp_path / "out", dtype=np.float32, passes=2,
+                        iteration="accumulate", warm=warm, partitions=2)
+    assert np.array_equal(np.asarray(solution.J).view(np.uint32), read_impulses_npz(oj).view(np.uint32))
+    for k in "vw":
+        assert np.array_equal(np.asarray(getattr(solution, k)).view(np.uint32), tool[k].view(np.uint32))
+
+
+def collide_solve_warm_error(bodies, contacts, warm, **options):
+    """collide.solve's exception (type, message) for this warm start (raised
+    before it writes anything: on the scene itself, so that a warm start
+    sharing its memory is seen as such)."""
+    with pytest.raises((TypeError, ValueError)) as e:
+        collide.solve(bodies, contacts, warm=warm, **options)
+    return type(e.value), str(e.value)
+
+
+def pulling(J0, contacts, k):
+    """J0 with contact k's J turned against its normal."""
+    bad = J0.copy()
+    bad[:, k] = -contacts.n[:, k]
+    return bad
+
+
+def test_a_bad_warm_start_gets_collide_solves_errors(client):
+    bodies, contacts, J0 = warm_frame("pairs")
+    m = len(contacts)
+    nan = pulling(J0, contacts, 1500)
+    nan[1, 40] = np.nan
+    cases = [(J0.astype(np.float64), {}), (np.ascontiguousarray(J0.T), {}), (J0.tolist(), {}),
+             (J0[:, :-1], {}), (pulling(J0, contacts, 17), {}), (nan, {}),
+             (bodies.v[:, :m], {}),  # shares memory with what the solve writes
+             (J0, {"iteration": "repeat"}), (J0, {"accuracy": "accurate"})]
+    v0 = bodies.v.copy()
+    for warm, extra in cases:
+        options = dict({"iteration": "accumulate", "passes": 2}, **extra)
+        kind, message = collide_solve_warm_error(bodies, contacts, warm, **options)
+        with pytest.raises(kind) as e:
+            cd.solve((bodies, contacts), client, warm=warm, **options)
+        assert str(e.value) == message
+        assert bodies.v.tobytes() == v0.tobytes(), "nothing written"
+    # The first refused J by row, named by its row in the scene.
+    assert collide_solve_warm_error(bodies, contacts, nan, iteration="accumulate")[1].startswith(
+        "solve: warm[:, 40] = (")
+    assert collide_solve_warm_error(bodies, contacts, pulling(J0, contacts, 17), iteration="accumulate")[1].startswith(
+        "solve: warm[:, 17] = (")
+
+
+def test_a_bad_warm_start_file_is_refused_naming_it(client, tmp_path):
+    bodies, contacts, J0 = warm_frame("pairs")
+    m = len(contacts)
+    bp, cp = str(tmp_path / "bodies.npz"), str(tmp_path / "contacts.npz")
+    collide.save(bp, cp, bodies, contacts)
+    out = tmp_path / "out"
+
+    def refused(kind, warm, match, **options):
+        with pytest.raises(kind, match=match):
+            cd.solve((bp, cp), client, out_dir=out, warm=warm, **dict({"iteration": "accumulate"}, **options))
+        assert not out.exists(), "nothing written"
+
+    path = lambda name: str(tmp_path / name)  # noqa: E731
+    refused(TypeError, J0, "for scene files, warm is the path of an impulses file")
+    refused(ValueError, J0, r"^a warm start needs iteration='accumulate'", iteration="repeat")
+    refused(FileNotFoundError, path("missing.npz"), "missing.npz")
+    np.savetxt(path("j.csv"), J0.T, delimiter=",", header="jx,jy,jz", comments="")
+    refused(ValueError, path("j.csv"), r"j\.csv: a warm start file is an impulses file \(.npz with jx, jy, jz")
+    np.savez(path("two.npz"), jx=J0[0], jy=J0[1])
+    refused(ValueError, path("two.npz"), r"two\.npz: an impulses file has the members jx, jy and jz .* has jx, jy$")
+    save_impulses(path("short.npz"), J0[:, :-1])
+    refused(ValueError, path("short.npz"), rf"short\.npz: warm holds {m - 1} impulses but {cp} holds {m} contacts")
+    np.save(path("short.npy"), np.ascontiguousarray(J0[:, :-1]))
+    refused(ValueError, path("short.npy"), rf"short\.npy: warm holds {m - 1} impulses")
+    np.save(path("rows.npy"), np.ascontiguousarray(J0.T))
+    refused(ValueError, path("rows.npy"), rf"rows\.npy: a warm start \.npy holds J, shape \(3, M\), got shape "
+                                          rf"\({m}, 3\)")
+    save_impulses(path("int.npz"), J0.astype(np.int32))
+    refused(ValueError, path("int.npz"), r"int\.npz: impulses are float32 or float64")
+    bad = pulling(J0, contacts, 17)
+    save_impulses(path("pull.npz"), bad)
+    _, message = collide_solve_warm_error(*collide.load(bp, cp), bad, iteration="accumulate")
+    assert message.startswith("solve: warm[:, 17] = (")
+    with pytest.raises(ValueError) as e:
+        cd.solve((bp, cp), client, out_dir=out, warm=path("pull.npz"), iteration="accumulate")
+    assert str(e.value) == path("pull.npz") + ": " + message.removeprefix("solve: ")
+    huge = J0.astype(np.float64)
+    huge[1, 33] = 1e300
+    save_impulses(path("huge.npz"), huge)
+    refused(ValueError, path("huge.npz"), r"huge\.npz: row 33, column 'jy': ", dtype=np.float32)
+
+
+def test_solve_scenes_from_warm_starts(client, tmp_path):
+    pile = {"kind": "pile", "n": 6, "seed": 2, "friction": True}
+    pile_bodies, pile_contacts = collide.generate("pile", 6, seed=2, friction=True)
+    pile_J0, _ = collide.solve(*copy_scene(pile_bodies, pile_contacts), passes=6, iteration="accumulate")
+    bodies, contacts, J0 = warm_frame("piles", np.float64)
+    bp, cp, jp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz"), str(tmp_path / "j0.npz")
+    collide.save(bp, cp, bodies, contacts)
+    save_impulses(jp, J0)
+    scenes = [pile, (bp, cp), {"kind": "pairs", "n": 2000}]
+    table = cd.solve_scenes(scenes, client, passes=2, iteration="accumulate", warm=[pile_J0, jp, None], sample=500)
+    assert list(table["contacts"]) == [len(pile_contacts), len(contacts), 2000]
+    assert (table["max_error_eps"] <= collide.error_bound_eps).all(), table["max_error_eps"]
+    # The sample's error is that of its solve from the first columns of the warm start.
+    sample_bodies, sample_contacts, _ = cd._tasks.sub_scene(pile_bodies, pile_contacts, np.arange(500))
+    start = np.ascontiguousarray(pile_J0[:, :500])
+    ref = collide.reference_solve(sample_bodies, sample_contacts, passes=2, iteration="accumulate", warm=start)
+    J, _ = collide.solve(sample_bodies, sample_contacts, model=table["model"][0], passes=2, iteration="accumulate",
+                         warm=start)
+    assert table["max_error_eps"][0] == collide.impulse_error(J, ref).max()
+
+    # Refused before anything runs, or by the scene's worker naming the scene.
+    with pytest.raises(TypeError, match="warm is a list, one warm start"):
+        cd.solve_scenes([pile], client, iteration="accumulate", warm=pile_J0)
+    with pytest.raises(ValueError, match=r"warm has 1 entries for 2 scenes"):
+        cd.solve_scenes([pile, pile], client, iteration="accumulate", warm=[pile_J0])
+    with pytest.raises(ValueError, match=r"^a warm start needs iteration='accumulate'"):
+        cd.solve_scenes([pile], client, warm=[pile_J0])
+    with pytest.raises(FileNotFoundError, match="scene 1: no such warm start file"):
+        cd.solve_scenes([pile, pile], client, iteration="accumulate", warm=[None, str(tmp_path / "missing.npz")])
+    m = len(pile_contacts)
+    with pytest.raises(ValueError, match=rf"^collide.dask.solve_scenes: scene 1: solve.warm has {m - 1} elements, "
+                                         rf"contacts.a has {m}$"):
+        cd.solve_scenes([pile, pile], client, iteration="accumulate", warm=[None, pile_J0[:, :-1]])
+    with pytest.raises(ValueError, match=r"^collide.dask.solve_scenes: scene 0: solve: warm\[:, 17\] = "):
+        cd.solve_scenes([pile], client, iteration="accumulate", warm=[pulling(pile_J0, pile_contacts, 17)])
+
+
+def test_the_command_takes_a_warm_start(client, tmp_path):
+    bodies, contacts, J0 = warm_frame("piles", np.float32, "colour")
+    bp, cp, jp = str(tmp_path / "b.npz"), str(tmp_path / "c.npz"), str(tmp_path / "j0.npz")
+    collide.save(bp, cp, bodies, contacts)
+    save_impulses(jp, J0)
+    J, after, _ = solved_copy(*collide.load(bp, cp), order="colour", passes=2, iteration="accumulate", warm=J0)
+    address = client.scheduler.address
+    common = ["--scheduler", address, "--no-progress", "--order", "colour", "--passes", "2"]
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "out"), *common, "--iteration", "accumulate",
+                "--warm-start", jp)
+    assert r.returncode == 0, r.stderr
+    stats = json.loads(r.stdout)
+    assert stats["warm_start"] is True and stats["iteration"] == "accumulate"
+    same_bits(cd.Solution(*(np.load(tmp_path / "out" / f"{k}.npy") for k in "Jvw"), {}), J, after)
+    # Without --iteration accumulate: a usage error, as `collide solve` gives it.
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "out2"), *common, "--warm-start", jp)
+    assert r.returncode == 2 and r.stderr.startswith("usage: python -m collide.dask solve "), r.stderr
+    assert r.stderr.endswith("error: --warm-start needs --iteration accumulate (the repeat mode's passes add "
+                             "impulses and cannot start from a J)\n"), r.stderr
+    assert not (tmp_path / "out2").exists()
+    save_impulses(str(tmp_path / "short.npz"), J0[:, :-1])
+    r = run_cli("solve", bp, cp, "--out-dir", str(tmp_path / "out2"), *common, "--iteration", "accumulate",
+                "--warm-start", str(tmp_path / "short.npz"))
+    assert r.returncode == 1 and r.stderr.startswith(f"collide-dask: error: {tmp_path / 'short.npz'}: warm holds"), \
+        r.stderr
+    # scenes: a spec entry's "warm", relative to the spec file.
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps([{"bodies": "b.npz", "contacts": "c.npz", "warm": "j0.npz"},
+                                {"kind": "pairs", "n": 100}]))
+    r = run_cli("scenes", str(spec), *common, "--iteration", "accumulate", "--sample", "200")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert len(lines) == 3 and lines[1].startswith("b.npz,") and f",float,fast,{len(contacts)}," in lines[1], lines
+    r = run_cli("scenes", str(spec), *common)
+    assert r.returncode == 1 and r.stderr == (f"collide-dask: error: {spec}: scene 0 has a warm start, which needs "
+                                              "--iteration accumulate (the repeat mode's passes add impulses and "
+                                              "cannot start from a J)\n"), r.stderr
 
 
 def test_import_collide_without_dask():

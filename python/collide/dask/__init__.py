@@ -31,6 +31,7 @@ import numpy as np
 
 import collide
 
+from ._files import MappedImpulses
 from ._partition import partition_islands, single_contact_ends
 from . import _cluster, _tasks
 
@@ -116,18 +117,22 @@ def _wait(futures, progress, what):
     return [f.result() for f in futures]
 
 
-def _options(model, sample=0, **solve):
+def _options(model, sample=0, warm_start=False, **solve):
     """The options of the tasks: ``model``, ``sample``, ``threads`` (the
-    task's share of the machine, _tasks.on_its_threads) and ``solve``, the
-    keywords every task passes to collide.solve (accuracy, order, passes,
-    iteration, threads, isa), checked and normalised by the library as collide.solve
-    checks them, with its messages (the ISA's name only: the workers' CPUs
-    decide whether they have it)."""
+    task's share of the machine, _tasks.on_its_threads), ``warm_start``
+    (whether a warm start is given) and ``solve``, the keywords every task
+    passes to collide.solve (accuracy, order, passes, iteration, threads,
+    isa), checked and normalised by the library as collide.solve checks
+    them, with its messages (the ISA's name only: the workers' CPUs decide
+    whether they have it; a warm start with iteration="repeat" gets
+    collide.solve's refusal)."""
     if model not in ("auto", "rigid", "sphere", "particle"):
         raise ValueError(f"model must be 'auto', 'rigid', 'sphere' or 'particle', got {model!r}")
-    checked = collide._collide.solve_options(**solve)
+    checked = collide._collide.solve_options(warm_start=warm_start, **solve)
     del checked["path"]
-    return {"model": model, "sample": int(sample), "threads": checked["threads"], "solve": checked}
+    warm_start = checked.pop("warm_start")  # collide.solve takes warm=, the J itself, not this flag
+    return {"model": model, "sample": int(sample), "threads": checked["threads"], "warm_start": warm_start,
+            "solve": checked}
 
 
 def _scene_model(bodies, contacts, model, loaded):
@@ -234,7 +239,8 @@ def _is_scene_files(scene):
 
 
 def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast", order="input", passes=1,
-          iteration="repeat", dtype=None, threads=1, isa=None, out_dir=None, workers=None, progress=False):
+          iteration="repeat", warm=None, dtype=None, threads=1, isa=None, out_dir=None, workers=None,
+          progress=False):
     """Solves one scene on Dask workers, island by island; the same bytes as
     :func:`collide.solve` on one machine. Returns a :class:`Solution` ``(J,
     v, w, stats)``.
@@ -266,6 +272,18 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     Bad values of these raise collide.solve's errors. A task lost with its
     worker is run again by Dask, writing the same bytes.
 
+    ``warm`` (with iteration="accumulate", as collide.solve's ``warm``) is a
+    warm start, the J of a solve before of the same contacts in the same
+    order; each partition starts from the columns of its contacts. For
+    arrays it is a (3, M) array of the scene's dtype; for scene files the
+    path of an impulses file every worker can read: an ``.npz`` with members
+    jx, jy, jz (``collide solve --out-impulses x.npz``) or a (3, M) ``.npy``,
+    such as the ``J.npy`` of an earlier solve, ``out_dir``'s own included
+    (the outputs replace it only once every partition is done), converted to
+    the scene's precision as a scene file is. The client checks it with
+    collide.solve's rules and messages before any task runs (the contact
+    named by its row in the scene; for a file, the file named too).
+
     ``client``: a ``distributed.Client``, a scheduler address, or None (the
     default client of this process, else a LocalCluster of ``workers``
     single-threaded processes, all cores by default, for this call).
@@ -277,7 +295,7 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     ``GIANT_ISLAND_SHARE`` of the contacts. ``stats``: collisions, bodies,
     islands, largest_island, largest_island_share, partitions (their contact
     counts), model, precision, accuracy, order, passes, iteration,
-    call_seconds (the
+    warm_start (True or False), call_seconds (the
     whole call, wall time), kernel_seconds (the partitions' solves, summed),
     collisions_per_second (collisions / kernel_seconds: the kernels'
     throughput, as collide.solve reports it), allocate_seconds (the allocate
@@ -287,12 +305,17 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
     its worker, read to write), islands_seconds, and for files read_seconds
     (the load and check on the client) and outputs (the three paths)."""
     started = time.perf_counter()
-    options = _options(model, accuracy=accuracy, order=order, passes=passes, iteration=iteration, threads=threads,
-                       isa=isa)
+    options = _options(model, warm_start=warm is not None, accuracy=accuracy, order=order, passes=passes,
+                       iteration=iteration, threads=threads, isa=isa)
     if _is_scene_files(scene):
         if out_dir is None:
             raise ValueError("collide.dask.solve: scene files need out_dir, where the workers write J, v and w")
-        return _solve_files(scene, client, partitions, options, dtype, os.fspath(out_dir), workers, progress, started)
+        if warm is not None and not isinstance(warm, (str, os.PathLike)):
+            raise TypeError(f"collide.dask.solve: for scene files, warm is the path of an impulses file every "
+                            f"worker can read (.npz with jx, jy, jz, or a (3, M) .npy such as a J.npy this "
+                            f"function wrote), got {type(warm).__name__}")
+        return _solve_files(scene, client, partitions, options, dtype, os.fspath(out_dir), warm, workers, progress,
+                            started)
     if not (isinstance(scene, (tuple, list)) and len(scene) == 2):
         raise TypeError("collide.dask.solve: scene must be (bodies, contacts): collide.Bodies and collide.Contacts, "
                         "or the paths of a binary scene file pair")
@@ -305,7 +328,7 @@ def solve(scene, client=None, *, partitions=None, model="auto", accuracy="fast",
                         "solved in their own precision")
     if out_dir is not None:
         raise ValueError("collide.dask.solve: out_dir is for scene files; arrays are updated in place")
-    return _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started)
+    return _solve_arrays(bodies, contacts, warm, client, partitions, options, workers, progress, started)
 
 
 def _stats(scene_model, precision, collisions, body_count, figures, counts, options, results, started, **extra):
@@ -318,17 +341,24 @@ def _stats(scene_model, precision, collisions, body_count, figures, counts, opti
             "model": scene_model, "precision": "float" if precision == np.float32 else "double",
             "accuracy": options["solve"]["accuracy"], "order": options["solve"]["order"],
             "passes": options["solve"]["passes"], "iteration": options["solve"]["iteration"],
-            "call_seconds": time.perf_counter() - started,
+            "warm_start": options["warm_start"], "call_seconds": time.perf_counter() - started,
             "kernel_seconds": kernel_seconds,
             "collisions_per_second": collisions / kernel_seconds if kernel_seconds > 0 else 0.0,
             "allocate_seconds": sum(r["allocate_seconds"] for r in results),
             "partition_seconds": [r["seconds"] for r in results], **extra}
 
 
-def _solve_arrays(bodies, contacts, client, partitions, options, workers, progress, started):
+def _solve_arrays(bodies, contacts, warm, client, partitions, options, workers, progress, started):
     if bodies.dtype != contacts.dtype:
         raise TypeError(f"bodies are {bodies.dtype} but contacts are {contacts.dtype}: one precision per solve")
+    if warm is not None:
+        # collide.solve's order: the array before the scene's values, its
+        # values after them.
+        _tasks.check_warm_array(warm, bodies, contacts)
     task, isl, figures, islands_seconds, solve_order = _prepare(bodies, contacts, options)
+    refusal = None if warm is None else _tasks.first_refused_warm(warm, bodies, contacts)
+    if refusal is not None:
+        raise ValueError(refusal)
     with _connected(client, workers) as c:
         order, counts, ends = _partitions(isl, partitions, c, solve_order)
         parts, futures = [], []
@@ -345,6 +375,9 @@ def _solve_arrays(bodies, contacts, client, partitions, options, workers, progre
                 payload = {"bodies": [getattr(sub_bodies, f) for f in ("inv_mass", "inv_inertia", "q", "p", "v", "w")],
                            "contacts": [sub_contacts.a, sub_contacts.b, sub_contacts.c, sub_contacts.n, sub_contacts.e,
                                         sub_contacts.uniform_e, sub_contacts.mu]}
+                if warm is not None:
+                    # The warm start's columns for the partition's contacts, in its sequence.
+                    payload["warm"] = np.ascontiguousarray(warm[:, rows])
                 parts.append((rows, ids))
                 futures.append(c.submit(_tasks.solve_part_arrays, payload, task, key=f"{key}-{p}", pure=False))
         results = _wait(futures, progress, "partitions")
@@ -359,7 +392,7 @@ def _solve_arrays(bodies, contacts, client, partitions, options, workers, progre
     return Solution(J, bodies.v, bodies.w, stats)
 
 
-def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, progress, started):
+def _solve_files(paths, client, partitions, options, dtype, out_dir, warm, workers, progress, started):
     bodies_path, contacts_path = (os.path.abspath(os.fspath(p)) for p in paths)
     for path in (bodies_path, contacts_path):
         if not path.endswith(".npz"):
@@ -367,6 +400,7 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
                              "`collide convert` writes one from CSV")
     t = time.perf_counter()
     bodies, contacts = collide.load(bodies_path, contacts_path, dtype=dtype)
+    warm_path = None if warm is None else _check_warm_file(warm, bodies, contacts, contacts_path)
     read_seconds = time.perf_counter() - t
     task, isl, figures, islands_seconds, solve_order = _prepare(bodies, contacts, options, loaded=True)
     os.makedirs(out_dir, exist_ok=True)
@@ -391,7 +425,8 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
             out.flush()
             del out
         common = {"bodies_path": bodies_path, "contacts_path": contacts_path, "body_count": n, "dtype": precision.name,
-                  "friction": contacts.mu is not None, "outputs": partial, "client_machine": _tasks.machine()}
+                  "friction": contacts.mu is not None, "outputs": partial, "client_machine": _tasks.machine(),
+                  "warm": warm_path}
         with _connected(client, workers) as c:
             order, counts, ends = _partitions(isl, partitions, c, solve_order)
             # A partition of consecutive contacts (a scene of independent
@@ -421,6 +456,22 @@ def _solve_files(paths, client, partitions, options, dtype, out_dir, workers, pr
     stats = _stats(task["model"], precision, m, n, figures, counts, options, results, started,
                    islands_seconds=islands_seconds, read_seconds=read_seconds, outputs=final)
     return Solution(*(np.load(final[k], mmap_mode="r") for k in ("J", "v", "w")), stats)
+
+
+def _check_warm_file(warm, bodies, contacts, contacts_path):
+    """The absolute path of the warm start file ``warm`` for the loaded
+    scene, after the checks collide.solve makes of an array (the scene's
+    values were checked by collide.load), the file and the contact named:
+    the workers then read their columns of it unchecked."""
+    path = os.path.abspath(os.fspath(warm))
+    impulses = MappedImpulses(path)
+    if impulses.count != len(contacts):  # `collide solve --warm-start`'s words
+        raise ValueError(f"{path}: warm holds {impulses.count} impulses but {contacts_path} holds {len(contacts)} "
+                         "contacts: a warm start gives one J per contact, in the same order")
+    refusal = _tasks.first_refused_warm(impulses.columns(slice(None), bodies.dtype), bodies, contacts)
+    if refusal is not None:
+        raise ValueError(f"{path}: {refusal.removeprefix('solve: ')}")
+    return path
 
 
 #: The columns of the table :func:`solve_scenes` returns, in order.
@@ -469,8 +520,24 @@ def _entry(i, item):
     return entry
 
 
+def _scene_warm(i, item):
+    """One warm start of solve_scenes as its worker takes it: an array, or
+    the absolute path of a file; the scene's worker checks it against the
+    scene, which only it holds."""
+    where = f"collide.dask.solve_scenes: scene {i}"
+    if isinstance(item, np.ndarray):
+        return item
+    if isinstance(item, (str, os.PathLike)):
+        path = os.path.abspath(os.fspath(item))
+        if not os.path.isfile(path):
+            raise FileNotFoundError(2, f"{where}: no such warm start file", path)
+        return path
+    raise TypeError(f"{where}: a warm start is None, a (3, M) array or the path of an impulses file, got "
+                    f"{type(item).__name__}")
+
+
 def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="input", passes=1,
-                 iteration="repeat", sample=10_000, threads=1, isa=None, workers=None, progress=False):
+                 iteration="repeat", warm=None, sample=10_000, threads=1, isa=None, workers=None, progress=False):
     """Solves many scenes, one task each, and measures each against the
     reference; returns a pandas DataFrame, one row per scene in the order
     given, columns ``SCENE_COLUMNS``: scene (its name), model (the one that
@@ -497,18 +564,41 @@ def solve_scenes(scenes, client=None, *, model="auto", accuracy="fast", order="i
     sample change them, and the sample measures the solver on a scene of
     its own. ``client``, ``workers`` and ``progress`` as for :func:`solve`.
 
+    ``warm`` (with iteration="accumulate") is a list with one warm start per
+    scene, in the order of ``scenes``: None (a cold start), a (3, M) array
+    of the scene's dtype, or the path of an impulses file (.npz with jx, jy,
+    jz, or a (3, M) .npy) the workers read. The scene's worker checks it
+    with collide.solve's rules and messages, naming the scene by its
+    number; the sample starts from its first columns, and the reference
+    from the same (the sample is then a scene of its own: a warm start's
+    visit applies every contact's J before the first pass).
+
     An entry that is not understood raises before anything runs (naming the
     entry); a scene file that is bad raises the reader's error (file, row,
     column)."""
     pandas = _need("pandas")
-    options = _options(model, sample, accuracy=accuracy, order=order, passes=passes, iteration=iteration,
-                       threads=threads, isa=isa)
+    if warm is not None and (isinstance(warm, (np.ndarray, str, os.PathLike, dict)) or not hasattr(warm, "__iter__")):
+        raise TypeError(f"collide.dask.solve_scenes: warm is a list, one warm start (or None) per scene, got "
+                        f"{type(warm).__name__}")
+    warm = None if warm is None else list(warm)
+    options = _options(model, sample, warm_start=warm is not None and any(w is not None for w in warm),
+                       accuracy=accuracy, order=order, passes=passes, iteration=iteration, threads=threads, isa=isa)
     if options["sample"] < 0:
         raise ValueError(f"sample must be >= 0, got {sample}")
     entries = [_entry(i, item) for i, item in enumerate(scenes)]
+    if warm is not None:
+        if len(warm) != len(entries):
+            raise ValueError(f"collide.dask.solve_scenes: warm has {len(warm)} entries for {len(entries)} scenes: "
+                             "one per scene, in their order (None for a cold start)")
+        entries = [entry if w is None else dict(entry, warm=_scene_warm(i, w), index=i)
+                   for i, (entry, w) in enumerate(zip(entries, warm))]
     with _connected(client, workers) as c:
         key = f"collide-dask-scene-{uuid.uuid4().hex}"
-        futures = [c.submit(_tasks.scene_row, entry, options, key=f"{key}-{i}", pure=False)
-                   for i, entry in enumerate(entries)]
+        with warnings.catch_warnings():
+            # A warm start given as an array goes with its task, as a
+            # partition's arrays do.
+            warnings.filterwarnings("ignore", message="Large object of size")
+            futures = [c.submit(_tasks.scene_row, entry, options, key=f"{key}-{i}", pure=False)
+                       for i, entry in enumerate(entries)]
         rows = _wait(futures, progress, "scenes")
     return pandas.DataFrame(rows, columns=list(SCENE_COLUMNS))

@@ -1,7 +1,7 @@
 """python -m collide.dask (and the collide-dask command): one scene split
 across Dask workers, or many scenes solved and measured.
 
-    python -m collide.dask solve BODIES.npz CONTACTS.npz --out-dir DIR [options]
+    python -m collide.dask solve BODIES.npz CONTACTS.npz --out-dir DIR [--iteration accumulate --warm-start J] [options]
     python -m collide.dask scenes SPEC.json | B1.npz C1.npz [B2.npz C2.npz ...] [--out TABLE.csv] [options]
 
 Every subcommand takes ``--scheduler ADDRESS`` (a running Dask scheduler)
@@ -11,8 +11,13 @@ into DIR and prints the stats as one JSON line; ``scenes`` writes the table
 as CSV (to stdout without --out). A spec file is a JSON list of scenes, each
 the parameters of collide.generate ({"kind": "pairs", "n": 10000, "seed": 3})
 or a file pair ({"bodies": "b.npz", "contacts": "c.npz"}, paths relative to
-the JSON file). Progress goes to stderr: dask.distributed.progress on a
-terminal, a line per finished task otherwise.
+the JSON file), either with an optional warm start ("warm": "j.npz", with
+--iteration accumulate). ``solve --warm-start FILE`` starts the accumulated
+passes from an impulses file (.npz with jx, jy, jz, as ``collide solve
+--out-impulses`` writes it, or a (3, M) .npy such as a J.npy of DIR), as
+``collide solve --warm-start`` does. Progress goes to stderr:
+dask.distributed.progress on a terminal, a line per finished task
+otherwise.
 
 Exit codes: 0 done; 1 bad input or a failed run (the message names the file,
 entry or array); 2 a bad command line.
@@ -57,16 +62,23 @@ def _parser():
     solve.add_argument("--partitions", type=int, default=None, help="default: the cluster's threads")
     solve.add_argument("--precision", choices=("float", "double"), default=None,
                        help="default: the file's own precision")
+    solve.add_argument("--warm-start", metavar="FILE", default=None,
+                       help="start the accumulated passes from the impulses in FILE (.npz with jx, jy, jz, as "
+                            "collide solve --out-impulses writes it, or a (3, M) .npy such as a J.npy of --out-dir: "
+                            "the previous frame's J of the same contacts); needs --iteration accumulate")
     scenes = sub.add_parser("scenes", parents=[common], help="solve and measure many scenes, one task each")
     scenes.add_argument("inputs", nargs="+", metavar="SPEC.json | BODIES.npz CONTACTS.npz",
                         help="a JSON spec file, or scene file pairs")
     scenes.add_argument("--out", default=None, help="the table as CSV (default: stdout)")
     scenes.add_argument("--sample", type=int, default=10_000, help="contacts compared with the reference per scene")
+    parser.subcommands = {"solve": solve, "scenes": scenes}  # for the usage errors found after parsing
     return parser
 
 
 def _scene_entries(inputs):
-    """The entries of the scenes subcommand: a spec file's, or file pairs."""
+    """The entries of the scenes subcommand, a spec file's or file pairs,
+    and their warm starts (None without any): a spec entry's "warm", a path
+    relative to the spec file, taken out of the entry."""
     if len(inputs) == 1 and inputs[0].endswith(".json"):
         path = inputs[0]
         with open(path, encoding="utf-8") as f:
@@ -77,18 +89,24 @@ def _scene_entries(inputs):
         if not isinstance(spec, list):
             raise ValueError(f"{path}: a spec file is a JSON list of scenes, got {type(spec).__name__}")
         base = os.path.dirname(os.path.abspath(path))
-        entries = []
+        entries, warm = [], []
         for i, item in enumerate(spec):
-            if isinstance(item, dict) and "bodies" in item:
-                item = dict(item, **{k: os.path.join(base, item[k]) for k in ("bodies", "contacts") if k in item})
-            elif not isinstance(item, dict):
+            if not isinstance(item, dict):
                 raise ValueError(f"{path}: scene {i}: an object, got {json.dumps(item)}")
+            item = dict(item)
+            start = item.pop("warm", None)
+            if start is not None and not isinstance(start, str):
+                raise ValueError(f"{path}: scene {i}: \"warm\" is the path of an impulses file, got "
+                                 f"{json.dumps(start)}")
+            warm.append(None if start is None else os.path.join(base, start))
+            if "bodies" in item:
+                item.update({k: os.path.join(base, item[k]) for k in ("bodies", "contacts") if k in item})
             entries.append(item)
-        return entries
+        return entries, warm if any(w is not None for w in warm) else None
     if len(inputs) % 2 or not all(p.endswith(".npz") for p in inputs):
         raise ValueError("scenes takes one spec file (.json) or pairs of binary scene files (BODIES.npz "
                          f"CONTACTS.npz ...), got {' '.join(inputs)}")
-    return [(inputs[i], inputs[i + 1]) for i in range(0, len(inputs), 2)]
+    return [(inputs[i], inputs[i + 1]) for i in range(0, len(inputs), 2)], None
 
 
 def _write_atomically(path, text):
@@ -114,7 +132,12 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 
 
 def main(argv=None):
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command == "solve" and args.warm_start is not None and args.iteration != "accumulate":
+        # `collide solve`'s usage error, as argparse reports one (exit 2).
+        parser.subcommands["solve"].error("--warm-start needs --iteration accumulate (the repeat mode's passes add "
+                                          "impulses and cannot start from a J)")
     warnings.showwarning = _show_warning
     try:
         import collide.dask as cd
@@ -127,10 +150,16 @@ def main(argv=None):
         if args.command == "solve":
             dtype = {"float": np.float32, "double": np.float64, None: None}[args.precision]
             solution = cd.solve((args.bodies, args.contacts), client, partitions=args.partitions, dtype=dtype,
-                                out_dir=args.out_dir, workers=workers, progress=progress, **_solve_options(args))
+                                warm=args.warm_start, out_dir=args.out_dir, workers=workers, progress=progress,
+                                **_solve_options(args))
             print(json.dumps(solution.stats))
         else:
-            table = cd.solve_scenes(_scene_entries(args.inputs), client, sample=args.sample, workers=workers,
+            entries, warm = _scene_entries(args.inputs)
+            if warm is not None and args.iteration != "accumulate":
+                first = next(i for i, w in enumerate(warm) if w is not None)
+                raise ValueError(f"{args.inputs[0]}: scene {first} has a warm start, which needs --iteration "
+                                 "accumulate (the repeat mode's passes add impulses and cannot start from a J)")
+            table = cd.solve_scenes(entries, client, warm=warm, sample=args.sample, workers=workers,
                                     progress=progress, **_solve_options(args))
             csv = table.to_csv(index=False)
             if args.out:

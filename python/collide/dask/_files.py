@@ -10,6 +10,10 @@ equal length, such as a file's ``vx``, ``vy``, ``vz``, are one stride apart
 in the file, so a range of them is a (3, k) view with no copy at all, as
 ``collide.load`` makes its arrays. The client has checked the whole scene
 with ``collide.load`` before any worker reads it.
+
+A warm start's impulses (:class:`MappedImpulses`: an impulses file's members
+``jx``, ``jy``, ``jz``, or a (3, M) ``.npy``) are mapped the same way, so
+that each worker reads the columns of its own contacts only.
 """
 
 from __future__ import annotations
@@ -103,6 +107,92 @@ class MappedNpz:
                 out[r] = c[rows]
             else:
                 np.take(c, rows, out=out[r])
+        return out
+
+
+#: The members of an impulses file (``collide solve --out-impulses x.npz``).
+IMPULSE_MEMBERS = ("jx", "jy", "jz")
+
+
+class MappedImpulses:
+    """The impulses J (3, M) of a warm start file, over a read-only mapping:
+    an impulses file (``.npz``, members ``jx``, ``jy``, ``jz``: what
+    ``collide solve --out-impulses x.npz`` writes) or a (3, M) ``.npy`` (the
+    ``J.npy`` collide.dask.solve writes). Members of float32 or float64, as
+    a scene file's. ValueError naming the file for anything else; OSError
+    for a file that cannot be read. ``count`` is M, ``dtype`` the stored
+    precision; :meth:`columns` reads the columns of some contacts only."""
+
+    def __init__(self, path):
+        path = os.fspath(path)
+        self.path = path
+        if path.endswith(".npz"):
+            try:
+                self._npz = MappedNpz(path)
+            except zipfile.BadZipFile as e:
+                raise ValueError(f"{path}: not an .npz archive: {e}") from None
+            have = sorted(self._npz.columns)
+            if any(k not in self._npz.columns for k in IMPULSE_MEMBERS):
+                raise ValueError(f"{path}: an impulses file has the members jx, jy and jz (what `collide solve "
+                                 f"--out-impulses x.npz` writes), this one has {', '.join(have) or 'none'}")
+            rows = [self._npz[k] for k in IMPULSE_MEMBERS]
+            where = [lambda i, k=k: f"row {i}, column '{k}'" for k in IMPULSE_MEMBERS]
+        elif path.endswith(".npy"):
+            self._npz = None
+            # A .npy of Python objects is refused: np.load does not unpickle.
+            try:
+                array = self._array = np.load(path, mmap_mode="r")
+            except ValueError as e:
+                raise ValueError(f"{path}: not a .npy array NumPy maps: {e}") from None
+            if array.ndim != 2 or array.shape[0] != 3:
+                raise ValueError(f"{path}: a warm start .npy holds J, shape (3, M), got shape {array.shape}")
+            rows = [array[k] for k in range(3)]
+            where = [lambda i, k=k: f"J[{k}, {i}]" for k in range(3)]
+        else:
+            raise ValueError(f"{path}: a warm start file is an impulses file (.npz with jx, jy, jz, as `collide "
+                             "solve --out-impulses x.npz` writes; `collide convert` writes one from CSV) or a (3, M) "
+                             ".npy such as the J.npy collide.dask.solve writes")
+        if any(r.ndim != 1 for r in rows) or len({r.shape for r in rows}) != 1:
+            raise ValueError(f"{path}: jx, jy and jz must be 1-D and of one length, got shapes "
+                             f"{', '.join(str(r.shape) for r in rows)}")
+        dtypes = {r.dtype for r in rows}
+        if len(dtypes) != 1 or rows[0].dtype not in (np.float32, np.float64):
+            raise ValueError(f"{path}: impulses are float32 or float64, one precision per file, got "
+                             f"{', '.join(str(r.dtype) for r in rows)}")
+        self._rows, self._where = rows, where
+        self.count, self.dtype = len(rows[0]), rows[0].dtype
+
+    def columns(self, rows, dtype):
+        """The J of contacts ``rows`` (a slice, or an array of row numbers),
+        in that order, as a (3, k) array of ``dtype``: a view of the mapping
+        where the rows are a range of values stored in ``dtype`` one stride
+        apart (a J.npy, the members of collide's writer), else a new array.
+        float64 values for float32 are rounded as the readers round a
+        scene's (the library's rounding, as ``collide solve --warm-start``
+        reads an impulses file), and a value beyond float is refused with
+        the readers' reason, naming the file, the row and the column."""
+        dtype = np.dtype(dtype)
+        if dtype == self.dtype:
+            if self._npz is not None:
+                return self._npz.stacked(IMPULSE_MEMBERS, rows, dtype)
+            if isinstance(rows, slice) and self._array.flags.c_contiguous:
+                return self._array[:, rows]
+            return np.ascontiguousarray(self._array[:, rows])
+        count = len(range(*rows.indices(self.count))) if isinstance(rows, slice) else len(rows)
+        out = np.empty((3, count), dtype)
+        for k, (row, where) in enumerate(zip(self._rows, self._where)):
+            values = np.require(row[rows], requirements=("C", "A"))
+            if self.dtype == np.float32:
+                out[k] = values  # float to double: exact
+                continue
+            try:
+                _collide.scene_values(values, out[k])
+            except ValueError as e:
+                # "scene_values: element i: reason", i counted in the rows read.
+                element, _, reason = str(e).partition(": ")[2].partition(": ")
+                at = int(element.split()[-1]) if element.startswith("element ") else 0
+                row_number = range(*rows.indices(self.count))[at] if isinstance(rows, slice) else int(rows[at])
+                raise ValueError(f"{self.path}: {where(row_number)}: {reason or e}") from None
         return out
 
 
