@@ -26,7 +26,8 @@
 //   (docs/decisions/0011-csv-scene-files.md).
 // * --check runs reference_solve<long double> on an exact copy of the inputs
 //   taken before the solve (convert_* copy without renormalising), in the
-//   solve's sequence (its schedule's order, --passes times), and
+//   solve's sequence (its schedule's order, --passes times, from the same
+//   --warm-start), and
 //   measures each impulse error in units of eps(T) * impulse_scale, the
 //   quantity kImpulseErrorBoundEps bounds (error_bound.hpp).
 // * --threads N also caps the tbb threads of parsing and writing, so
@@ -44,8 +45,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -61,6 +64,7 @@
 #include "collide/model.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
+#include "collide/validate.hpp"
 #include "commands.hpp"
 
 namespace collide::cli {
@@ -71,7 +75,7 @@ const char* const kSolveUsage =
     "                     [--path simd|scalar]\n"
     "                     [--isa auto|sse2|avx2|avx512] [--layout auto|soa|packed]\n"
     "                     [--accuracy fast|accurate] [--order input|colour] [--passes N]\n"
-    "                     [--iteration repeat|accumulate]\n"
+    "                     [--iteration repeat|accumulate] [--warm-start IMPULSES]\n"
     "                     [--model rigid|sphere|particle|auto] [--stats] [--check]\n"
     "\n"
     "Resolves every contact of the scene by the collision law and writes the bodies\n"
@@ -116,6 +120,10 @@ const char* const kSolveUsage =
     "                        (each contact's total impulse moved towards rest and\n"
     "                        clamped, restitution once, J the totals: converges as\n"
     "                        physics engines' passes do; fast accuracy only)\n"
+    "  --warm-start FILE     start the accumulated passes from the impulses in FILE\n"
+    "                        (CSV or .npz by its name, as --out-impulses writes it:\n"
+    "                        the previous frame's J of the same contacts, one row\n"
+    "                        each); needs --iteration accumulate\n"
     "  --model M             body model of the kernel: auto (default) for the cheapest\n"
     "                        that fits the scene, or rigid, sphere or particle (an\n"
     "                        error when the scene does not fit); results are the law's\n"
@@ -149,6 +157,7 @@ struct SolveRequest {
   Order order = Order::input;
   int passes = 1;
   Iteration iteration = Iteration::repeat;
+  std::string warm_start_path;  // empty: no warm start
   bool auto_model = true;
   Model model = Model::rigid;
   bool stats = false;
@@ -163,14 +172,44 @@ int solve_scene(const SolveRequest& req) {
   const LoadedBodies<T> table = load_bodies<T>(req.bodies_path, req.bodies_format, BodyRules::by_caller);
   SolveBodies<T> bodies(table);
   const LoadedContacts<T> contacts = load_contacts<T>(req.contacts_path, req.contacts_format, table.size());
+  // The warm start is the solve's impulse arrays on entry.
+  ImpulseBuffer<T> impulses(contacts.size());
+  if (!req.warm_start_path.empty()) {
+    impulses = load_impulses<T>(req.warm_start_path, scene_format_of(req.warm_start_path));
+    if (impulses.size() != contacts.size()) {
+      throw std::runtime_error(req.warm_start_path + ": --warm-start holds " + std::to_string(impulses.size()) +
+                               " impulses but " + req.contacts_path + " holds " + std::to_string(contacts.size()) +
+                               " contacts: a warm start gives one J per contact, in the same order");
+    }
+    // The solver refuses the same J; named here by the file's terms.
+    const ImpulseView<const T> warm = std::as_const(impulses).view();
+    if (const std::size_t k = first_refused_warm_start(contacts.view(), warm); k < contacts.size()) {
+      std::ostringstream j;
+      j << std::setprecision(std::numeric_limits<T>::max_digits10) << warm.j.x[k] << ", " << warm.j.y[k] << ", "
+        << warm.j.z[k];
+      throw std::runtime_error(req.warm_start_path + ": the J of contact " + std::to_string(k) + " (" + j.str() + ") " +
+                               warm_start_refusal(contacts.view(), warm, k));
+    }
+  }
   const double read_seconds = seconds_since(t_read);
 
   // The reference must see the inputs the kernel sees: copy before solving.
   BodyBuffer<long double> ref_bodies;
   ContactBuffer<long double> ref_contacts;
+  ImpulseBuffer<long double> ref_impulses;
   if (req.check) {
     ref_bodies = convert_bodies<long double>(std::as_const(bodies).view());
     ref_contacts = convert_contacts<long double>(contacts.view());
+    ref_impulses.resize(contacts.size());
+    if (!req.warm_start_path.empty()) {
+      const ImpulseView<long double> to = ref_impulses.view();
+      const ImpulseView<const T> from = std::as_const(impulses).view();
+      for (std::size_t k = 0; k < contacts.size(); ++k) {
+        to.j.x[k] = from.j.x[k];
+        to.j.y[k] = from.j.y[k];
+        to.j.z[k] = from.j.z[k];
+      }
+    }
   }
 
   // A smaller model computes the law only for scenes that fit it.
@@ -195,8 +234,8 @@ int solve_scene(const SolveRequest& req) {
   options.order = req.order;
   options.passes = req.passes;
   options.iteration = req.iteration;
+  options.warm_start = !req.warm_start_path.empty();
   const Solver solver(options);
-  ImpulseBuffer<T> impulses(contacts.size());
   const auto t_kernel = Clock::now();
   const SolveStats stats = solver.solve(model, bodies.view(), contacts.view(), impulses.view(), schedule);
   const double kernel_seconds = seconds_since(t_kernel);
@@ -205,11 +244,12 @@ int solve_scene(const SolveRequest& req) {
   double check_seconds = 0;
   if (req.check) {
     const auto t_check = Clock::now();
-    ImpulseBuffer<long double> ref_impulses(contacts.size());
     std::vector<ReferenceContact<long double>> diag(contacts.size());
-    // In the solve's own sequence: its schedule's order, pass after pass.
-    reference_solve<long double>(ref_bodies.view(), ref_contacts.view(), ref_impulses.view(), diag.data(),
-                                 SolveSequence{schedule.order(), static_cast<std::size_t>(req.passes), req.iteration});
+    // In the solve's own sequence: its schedule's order, pass after pass,
+    // from the same warm start.
+    reference_solve<long double>(
+        ref_bodies.view(), ref_contacts.view(), ref_impulses.view(), diag.data(),
+        SolveSequence{schedule.order(), static_cast<std::size_t>(req.passes), req.iteration, options.warm_start});
     check = check_impulses<T>(std::as_const(impulses).view(), std::as_const(ref_impulses).view(), diag);
     check_seconds = seconds_since(t_check);
   }
@@ -301,6 +341,7 @@ int run_solve(int argc, char** argv) {
                                      {"order", true},
                                      {"passes", true},
                                      {"iteration", true},
+                                     {"warm-start", true},
                                      {"model", true},
                                      {"stats", false},
                                      {"check", false},
@@ -414,6 +455,14 @@ int run_solve(int argc, char** argv) {
     if (req.iteration == Iteration::accumulate && req.accuracy == Accuracy::accurate) {
       throw UsageError("--iteration accumulate runs in the fast mode: it takes --accuracy fast");
     }
+  }
+  if (const auto it = opt.find("warm-start"); it != opt.end()) {
+    if (req.iteration != Iteration::accumulate) {
+      throw UsageError(
+          "--warm-start needs --iteration accumulate (the repeat mode's passes add impulses and "
+          "cannot start from a J)");
+    }
+    req.warm_start_path = it->second;
   }
   if (const auto it = opt.find("layout"); it != opt.end()) {
     if (it->second == "auto") {

@@ -772,6 +772,50 @@ COLLIDE_LANE_INLINE ContactResult<V> accumulated_step(BodyLanes<M, V>& a, BodyLa
   return result;
 }
 
+/// The warm start of W contacts (SolverOptions::warm_start): two visits of
+/// their own before the first accumulated pass, as Box2D stores each
+/// contact's relative velocity when it prepares the contacts and warm-starts
+/// all of them (b2WarmStartContactsTask) before its first iteration.
+///
+/// The first visit measures every target from the velocities the solve was
+/// given, before any impulse: -e vn where the contact approaches, 0 where it
+/// does not (or has no movable body). A resting contact that only its own
+/// support holds up meets its bodies moving together and asks for no bounce.
+///
+/// The second applies the totals the caller's J gave, as the law applies an
+/// impulse: lambda n along the normal's lever arms and, with friction, -G
+/// along its own. Every contact's totals are on the bodies before any
+/// contact steps, so no step sees a neighbour's support missing and undoes
+/// its own. A contact without a movable body keeps no totals, as a pass
+/// leaves it none.
+template <class M, class V>
+COLLIDE_LANE_INLINE void warm_start_target(const BodyLanes<M, V>& a, const BodyLanes<M, V>& b,
+                                           const ContactLanes<V>& contact, const ContactGeometry<V>& g,
+                                           Accumulated<V>& acc) {
+  const V vn = dot(relative_velocity(a, b, g.ra, g.rb), contact.n);
+  const auto movable = inverse_effective_mass(a, b, g.arm_a, g.arm_b) > V(0);
+  acc.target = select(movable && (vn < V(0)), V(0) - contact.e * vn, V(0));
+}
+
+template <class M, class V, bool kFriction>
+COLLIDE_LANE_INLINE void warm_start_step(BodyLanes<M, V>& a, BodyLanes<M, V>& b, const ContactLanes<V>& contact,
+                                         const ContactGeometry<V>& g, Accumulated<V>& acc) {
+  const auto movable = inverse_effective_mass(a, b, g.arm_a, g.arm_b) > V(0);
+  acc.normal = select(movable, acc.normal, V(0));
+  apply_impulse(a, b, contact.n, acc.normal, g.arm_a, g.arm_b, movable && (acc.normal != V(0)));
+  if constexpr (kFriction) {
+    const Vec3<V> zero{V(0), V(0), V(0)};
+    acc.friction = select(movable, acc.friction, zero);
+    const Vec3<V>& f = acc.friction;
+    const auto moves = movable && ((f.x != V(0)) || (f.y != V(0)) || (f.z != V(0)));
+    const LeverArm<V> farm_a = lever_arm(a, g.ra, f, contact.c);
+    const LeverArm<V> farm_b = lever_arm(b, g.rb, f, contact.c);
+    apply_impulse(a, b, f, V(-1), farm_a, farm_b, moves);
+  }
+  Vec3<V> none{V(0), V(0), V(0)};
+  canonical_outputs(a, b, none);
+}
+
 /// The two accumulated passes with their geometry formed first (as
 /// evaluate_law composes the law's halves).
 template <class M, class V, bool kFriction>

@@ -4,12 +4,18 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/parallel_reduce.h>
 #include <oneapi/tbb/partitioner.h>
 
+#include "collide/validate.hpp"
 #include "first_touch.hpp"
 
 namespace collide::detail {
@@ -55,6 +61,57 @@ AccumulatedView<T> IterationScratch<T>::totals(bool friction) {
     for (int k = 0; k < 3; ++k) view.friction[k] = friction_[k].data();
   }
   return view;
+}
+
+template <class T>
+void IterationScratch<T>::warm(tbb::task_arena& arena, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                               const std::uint32_t* order, bool friction, bool save) {
+  assert(normal_.size() >= contacts.count && (!save || saved_[0].size() >= contacts.count));
+  const std::size_t none = contacts.count;
+  const std::size_t bad = arena.execute([&] {
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, contacts.count, kContactsPerTask), none,
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t first_bad) {
+          for (std::size_t p = r.begin(); p < r.end(); ++p) {
+            const std::size_t k = order != nullptr ? order[p] : p;
+            const T jx = impulses.j.x[k];
+            const T jy = impulses.j.y[k];
+            const T jz = impulses.j.z[k];
+            const T nx = contacts.n.x[k];
+            const T ny = contacts.n.y[k];
+            const T nz = contacts.n.z[k];
+            // lambda n is J's part along n; G = lambda n - J the rest, kept
+            // only where friction can act on it (mu > 0).
+            const T along = jx * nx + jy * ny + jz * nz;
+            const T lambda = std::max(along / (nx * nx + ny * ny + nz * nz), T(0));
+            const bool kept = friction && contacts.mu[k] > T(0);
+            normal_[p] = lambda;
+            target_[p] = T(0);  // measured by the first pass
+            if (friction) {
+              friction_[0][p] = kept ? nx * lambda - jx : T(0);
+              friction_[1][p] = kept ? ny * lambda - jy : T(0);
+              friction_[2][p] = kept ? nz * lambda - jz : T(0);
+            }
+            if (save) {
+              saved_[0][p] = jx;
+              saved_[1][p] = jy;
+              saved_[2][p] = jz;
+            }
+            const T j[3] = {jx, jy, jz};
+            const T n[3] = {nx, ny, nz};
+            if (!warm_start_accepted(j, n) && k < first_bad) first_bad = k;
+          }
+          return first_bad;
+        },
+        [](std::size_t x, std::size_t y) { return std::min(x, y); }, tbb::static_partitioner());
+  });
+  if (bad == none) return;
+  std::ostringstream at;
+  at << std::setprecision(std::numeric_limits<T>::max_digits10) << "impulses.j[" << bad << "] = (" << impulses.j.x[bad]
+     << ", " << impulses.j.y[bad] << ", " << impulses.j.z[bad] << ")";
+  const ImpulseView<const T> warm{impulses.count, {impulses.j.x, impulses.j.y, impulses.j.z}};
+  throw std::invalid_argument("collide::Solver::solve: warm start " + at.str() + " " +
+                              warm_start_refusal(contacts, warm, bad));
 }
 
 template <class T>

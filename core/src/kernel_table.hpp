@@ -93,6 +93,11 @@ struct AccumulatedView {
   T* friction[3] = {};  ///< G [N s]: the friction impulse on a is -G (with friction only)
 };
 
+/// A warm start's visits before the first accumulated pass (contact_kernel.hpp,
+/// warm_start_target and warm_start_step): none, the targets measured from
+/// the velocities the solve was given, or the totals applied to the bodies.
+enum class WarmVisit : std::uint8_t { none, targets, apply };
+
 /// Everything a kernel needs besides the range: the bodies in the view of
 /// `model` and layout (only that member is set), the contacts, where J goes,
 /// and the schedule's order.
@@ -123,6 +128,9 @@ struct KernelJob {
   /// writes J and moves the totals there (the first pass records them).
   AccumulatedView<T> accumulated;
   bool first_pass = false;  ///< the accumulated pass is the first: the law, recording the totals
+  /// With first_pass: the walk is one of a warm start's visits
+  /// (SolverOptions::warm_start), before the passes; they write no J.
+  WarmVisit warm = WarmVisit::none;
 
   [[nodiscard]] bool accumulates() const { return accumulated.normal != nullptr; }
 };

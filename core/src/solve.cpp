@@ -162,6 +162,11 @@ void check_options(const SolverOptions& options) {
     throw std::invalid_argument(
         "collide::Solver: iteration accumulate runs in the fast mode; accuracy accurate takes iteration repeat");
   }
+  if (options.warm_start && options.iteration != Iteration::accumulate) {
+    throw std::invalid_argument(
+        "collide::Solver: a warm start needs iteration accumulate (the repeat mode's passes add impulses and "
+        "cannot start from a J)");
+  }
 }
 
 }  // namespace
@@ -198,7 +203,10 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   // Several passes keep J before the last one for the residual; the
   // accumulated passes keep their totals. Sized in the allocate phase.
   const bool accumulates = options.iteration == Iteration::accumulate;
-  const bool measures = plan.passes > 1;
+  // A warm start measures its one pass too: against the J it started from.
+  const bool warm = options.warm_start;
+  const bool measures = plan.passes > 1 || warm;
+  const bool prepares = detail::prepares_contacts(schedule);
   std::unique_lock<std::mutex> iteration_lock(iteration_mutex, std::defer_lock);
   detail::KernelJob<T> iterated = job;
   if (accumulates || measures) {
@@ -208,28 +216,53 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
       allocate_seconds += seconds_since(t_allocate);
     }
     if (accumulates) iterated.accumulated = iteration<T>().totals(job.friction);
+    // The totals are indexed as the walked J is: by prepared position when
+    // the contacts are prepared in the schedule's order.
+    if (warm) {
+      iteration<T>().warm(*arena, job.contacts, job.impulses, prepares ? schedule.order() : nullptr, job.friction,
+                          measures);
+    }
   }
   double residual = 1;
-  // The passes, the last one apart when the residual is measured.
+  // A warm start's visit, then the passes, the last one apart when the
+  // residual is measured.
   const auto walk = [&](const detail::KernelJob<T>& on) {
-    if (!measures) return detail::walk_schedule(table, plan, *arena, on, schedule);
-    detail::WalkPlan before = plan;
-    before.passes = plan.passes - 1;
-    const std::size_t done = detail::walk_schedule(table, before, *arena, on, schedule);
-    if (done < before.passes || (plan.stop != nullptr && plan.stop->load(std::memory_order_relaxed))) {
-      residual = std::numeric_limits<double>::quiet_NaN();
-      return done;
+    detail::WalkPlan rest = plan;
+    if (warm) {
+      // Its two visits, before any contact steps (warm_start_target, then
+      // warm_start_step): no pass of the solve's count, and J written by
+      // the passes that follow.
+      detail::WalkPlan visit = plan;
+      visit.passes = 1;
+      for (const detail::WarmVisit kind : {detail::WarmVisit::targets, detail::WarmVisit::apply}) {
+        detail::KernelJob<T> visiting = on;
+        visiting.warm = kind;
+        (void)detail::walk_schedule(table, visit, *arena, visiting, schedule);
+      }
+      rest.continues = true;
     }
-    iteration<T>().save(*arena, on.impulses);
-    detail::WalkPlan last = plan;
+    if (!measures) return detail::walk_schedule(table, rest, *arena, on, schedule);
+    detail::WalkPlan before = rest;
+    before.passes = plan.passes - 1;
+    // A warm start's one pass is measured against the J it started from,
+    // which warm() saved.
+    if (before.passes > 0) {
+      const std::size_t done = detail::walk_schedule(table, before, *arena, on, schedule);
+      if (done < before.passes || (plan.stop != nullptr && plan.stop->load(std::memory_order_relaxed))) {
+        residual = std::numeric_limits<double>::quiet_NaN();
+        return done;
+      }
+      iteration<T>().save(*arena, on.impulses);
+    }
+    detail::WalkPlan last = rest;
     last.passes = 1;
-    last.continues = true;
+    last.continues = rest.continues || before.passes > 0;
     detail::walk_schedule(table, last, *arena, on, schedule);
     residual = iteration<T>().residual(*arena, on.impulses);
     return plan.passes;
   };
   std::size_t passes = 0;
-  if (detail::prepares_contacts(schedule)) {
+  if (prepares) {
     // Copied in, walked every pass, J copied out: the copies cost two
     // streaming passes, the gathers they spare one per colour. With several
     // passes of the fast frictionless law, the velocity-free half is formed
@@ -270,6 +303,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.overflow_contacts = schedule.overflow_contacts();
   stats.passes = passes;
   stats.iteration = options.iteration;
+  stats.warm_start = warm;
   stats.residual = residual;
   return stats;
 }

@@ -32,11 +32,14 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <limits>
 #include <numeric>
 #include <sstream>
 #include <type_traits>
 #include <vector>
+
+#include "collide/accuracy.hpp"
 
 #include "collide/rules.hpp"
 #include "contact_indices.hpp"
@@ -609,6 +612,59 @@ Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t 
 }
 
 // Written out (clang-tidy: no macros over types).
+template <class T>
+bool warm_start_accepted(const T (&j)[3], const T (&n)[3]) {
+  const auto length = [](const T(&x)[3]) {
+    return std::sqrt(double(x[0]) * double(x[0]) + double(x[1]) * double(x[1]) + double(x[2]) * double(x[2]));
+  };
+  if (!(std::isfinite(j[0]) && std::isfinite(j[1]) && std::isfinite(j[2]))) return false;
+  const double along = double(j[0]) * double(n[0]) + double(j[1]) * double(n[1]) + double(j[2]) * double(n[2]);
+  return along >= -kImpulseErrorBoundEps * double(std::numeric_limits<T>::epsilon()) * length(j) * length(n);
+}
+
+namespace {
+template <class T>
+void warm_start_at(const ContactView<T>& contacts, const ImpulseView<const T>& warm, std::size_t k, T (&j)[3],
+                   T (&n)[3]) {
+  j[0] = warm.j.x[k];
+  j[1] = warm.j.y[k];
+  j[2] = warm.j.z[k];
+  n[0] = contacts.n.x[k];
+  n[1] = contacts.n.y[k];
+  n[2] = contacts.n.z[k];
+}
+}  // namespace
+
+template <class T>
+std::size_t first_refused_warm_start(const ContactView<T>& contacts, const ImpulseView<const T>& warm) {
+  for (std::size_t k = 0; k < contacts.count; ++k) {
+    T j[3], n[3];
+    warm_start_at(contacts, warm, k, j, n);
+    if (!warm_start_accepted(j, n)) return k;
+  }
+  return contacts.count;
+}
+
+template <class T>
+std::string warm_start_refusal(const ContactView<T>& contacts, const ImpulseView<const T>& warm, std::size_t k) {
+  T j[3], n[3];
+  warm_start_at(contacts, warm, k, j, n);
+  if (!(std::isfinite(j[0]) && std::isfinite(j[1]) && std::isfinite(j[2]))) return "is not finite";
+  const double along = double(j[0]) * double(n[0]) + double(j[1]) * double(n[1]) + double(j[2]) * double(n[2]);
+  std::ostringstream text;
+  text << std::setprecision(std::numeric_limits<T>::max_digits10) << "has J . n = " << along
+       << " < 0: a normal impulse never pulls the bodies together";
+  return text.str();
+}
+
+template bool warm_start_accepted<float>(const float (&)[3], const float (&)[3]);
+template bool warm_start_accepted<double>(const double (&)[3], const double (&)[3]);
+template std::size_t first_refused_warm_start<float>(const ContactView<float>&, const ImpulseView<const float>&);
+template std::size_t first_refused_warm_start<double>(const ContactView<double>&, const ImpulseView<const double>&);
+template std::string warm_start_refusal<float>(const ContactView<float>&, const ImpulseView<const float>&, std::size_t);
+template std::string warm_start_refusal<double>(const ContactView<double>&, const ImpulseView<const double>&,
+                                                std::size_t);
+
 template Validation validate<float>(const BodyView<float>&, const ContactView<float>&, const ImpulseView<float>&);
 template Validation validate<float>(const SphereView<float>&, const ContactView<float>&, const ImpulseView<float>&);
 template Validation validate<float>(const ParticleView<float>&, const ContactView<float>&, const ImpulseView<float>&);

@@ -125,6 +125,7 @@ StatRecord solve_record(const SolveStats& stats, const ImpulseView<const T>& imp
   r.emplace_back("order", std::string(to_string(stats.order)));
   r.emplace_back("passes", U(stats.passes));
   r.emplace_back("iteration", std::string(to_string(stats.iteration)));
+  r.emplace_back("warm_start", stats.warm_start);
   r.emplace_back("residual", stats.residual);
   r.emplace_back("batches", U(stats.batches));
   r.emplace_back("largest_batch", U(stats.largest_batch));

@@ -191,7 +191,73 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
   const bool accumulates = sequence.iteration == Iteration::accumulate;
   std::vector<S> total_normal(accumulates ? contacts.count : 0, S(0));
   std::vector<S> target(accumulates ? contacts.count : 0, S(0));
-  std::vector<Vec<S>> total_friction(accumulates ? contacts.count : 0);
+  std::vector<Vec<S>> total_friction(accumulates ? contacts.count : 0, Vec<S>::Zero());
+  // A warm start's totals come from the J the arrays hold (SolverOptions::
+  // warm_start): lambda the part along the unit normal, never below 0, and
+  // the rest as -G where friction can act (mu > 0). Visits of their own
+  // measure the targets and apply the totals; every pass is then a later one.
+  const bool warm = accumulates && sequence.warm_start;
+  std::vector<S> warm_size(warm ? contacts.count : 0, S(0));
+  if (warm) {
+    for (std::size_t k = 0; k < contacts.count; ++k) {
+      const V3 jw(impulses.j.x[k], impulses.j.y[k], impulses.j.z[k]);
+      const V3 n = V3(contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]).normalized();
+      const S lambda = std::max(jw.dot(n), S(0));
+      total_normal[k] = lambda;
+      const S mu = contacts.mu ? contacts.mu[k] : S(0);
+      if (mu > S(0)) total_friction[k] = lambda * n - jw;
+      warm_size[k] = jw.norm();
+    }
+  }
+  if (warm) {
+    // The warm start's two visits, before the passes (as the kernels' own
+    // walks): every target from the velocities the solve was given (a
+    // contact that does not approach then, or has no movable body, asks for
+    // none), then each contact's totals applied in the sequence. What the
+    // kernel rounds in applying them reaches the bodies' contacts as any
+    // impulse's does.
+    const auto visit = [&](std::size_t at, bool apply_totals) {
+      const std::size_t k = sequence.order != nullptr ? sequence.order[at] : at;
+      const std::size_t ia = contacts.a[k];
+      const std::size_t ib = contacts.b[k];
+      RefBody<S> a(bodies, ia);
+      RefBody<S> b(bodies, ib);
+      const V3 c(contacts.c.x[k], contacts.c.y[k], contacts.c.z[k]);
+      const V3 n = V3(contacts.n.x[k], contacts.n.y[k], contacts.n.z[k]).normalized();
+      const V3 ra = c - a.p;
+      const V3 rb = c - b.p;
+      const V3 ran = ra.cross(n);
+      const V3 rbn = rb.cross(n);
+      const S k_n = a.inv_mass + b.inv_mass + ran.dot(a.inv_inertia_world(ran)) + rbn.dot(b.inv_inertia_world(rbn));
+      if (!apply_totals) {
+        const S e = contacts.e ? contacts.e[k] : contacts.uniform_e;
+        const S vn = V3((a.v + a.w.cross(ra)) - (b.v + b.w.cross(rb))).dot(n);
+        target[k] = k_n != S(0) && vn < S(0) ? -e * vn : S(0);
+        return;
+      }
+      if (k_n == S(0)) {
+        total_normal[k] = S(0);
+        total_friction[k] = V3::Zero();
+        return;
+      }
+      const V3 p = total_normal[k] * n - total_friction[k];
+      a.v += p * a.inv_mass;
+      a.w += a.inv_inertia_world(ra.cross(p));
+      b.v -= p * b.inv_mass;
+      b.w -= b.inv_inertia_world(rb.cross(p));
+      a.store(bodies, ia);
+      b.store(bodies, ib);
+      if constexpr (kErrorAnalysis) {
+        const S size = warm_size[k];
+        inherited_v[ia] += size * a.inv_mass;
+        inherited_w[ia] += size * a.inv_inertia_max * ra.norm();
+        inherited_v[ib] += size * b.inv_mass;
+        inherited_w[ib] += size * b.inv_inertia_max * rb.norm();
+      }
+    };
+    for (std::size_t at = 0; at < contacts.count; ++at) visit(at, false);
+    for (std::size_t at = 0; at < contacts.count; ++at) visit(at, true);
+  }
   for (std::size_t step = 0; step < sequence.passes * contacts.count; ++step) {
     const std::size_t pass = step / contacts.count;
     const std::size_t at = step % contacts.count;
@@ -270,12 +336,15 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
     // evaluation's own rounding can move J by; it is what the bodies inherit.
     S own_scale = 0;
     S own_before = 0;
+    // What the kernel rounds in turning a warm start's J into totals is of
+    // the size of |J|: it joins the first pass's scale.
+    const S warm_scale = warm && pass == 0 ? warm_size[k] : S(0);
     if constexpr (kErrorAnalysis) {
       own_before = own_speed_scale();
       d.speed_scale = own_before + inherited_speed();
       if (d.k_n != S(0)) {
         const S lever = ref_abs(d.vn) * lever_sensitivity(n) / d.k_n;
-        d.impulse_scale = (S(1) + e) * (d.speed_scale + lever) / d.k_n;
+        d.impulse_scale = (S(1) + e) * (d.speed_scale + lever) / d.k_n + warm_scale;
         own_scale = (S(1) + e) * (own_before + lever) / d.k_n;
       }
     }
@@ -288,7 +357,7 @@ void solve_law(const BodyView<S>& bodies, const ContactView<S>& contacts, const 
              (before + after + after_normal) / k_t * (S(1) + compliance_times(t).norm() / k_t) +
              jt * lever_sensitivity(t) / k_t;
     };
-    if (accumulates && pass > 0) {
+    if (accumulates && (pass > 0 || warm)) {
       // A later accumulated pass (docs/collision-law.md, "Iteration"): the
       // normal total moved towards the target and clamped at 0, then the
       // friction total moved by what stops the sliding and clamped to the
@@ -430,7 +499,7 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
                      ReferenceContact<S>* diagnostics, const SolveSequence& sequence) {
   using R = typename ShorterPrecision<S>::type;
   if constexpr (!std::is_void_v<R>) {
-    if (diagnostics != nullptr && sequence.passes > 1) {
+    if (diagnostics != nullptr && (sequence.passes > 1 || sequence.warm_start)) {
       // Over several passes the law itself may amplify rounding: Coulomb
       // friction's passes are not a contraction, and two evaluations that
       // differ by rounding can drift apart pass after pass, which no
@@ -443,6 +512,13 @@ void reference_solve(const BodyView<S>& bodies, const ContactView<S>& contacts, 
       BodyBuffer<R> replay_bodies = convert_bodies<R>(bodies);
       const ContactBuffer<R> replay_contacts = convert_contacts<R>(contacts);
       ImpulseBuffer<R> replay_j(contacts.count);
+      if (sequence.warm_start) {  // the same warm start, exactly: R holds the kernel's J
+        for (std::size_t k = 0; k < contacts.count; ++k) {
+          replay_j.view().j.x[k] = R(impulses.j.x[k]);
+          replay_j.view().j.y[k] = R(impulses.j.y[k]);
+          replay_j.view().j.z[k] = R(impulses.j.z[k]);
+        }
+      }
       solve_law<R, false>(replay_bodies.view(), replay_contacts.view(), replay_j.view(), nullptr, sequence);
       solve_law<S, true>(bodies, contacts, impulses, diagnostics, sequence);
       const ImpulseView<const R> r = std::as_const(replay_j).view();

@@ -126,14 +126,14 @@ class Stats(dict):
 
 
 def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", order="input",
-          passes=1, iteration="repeat", schedule=None, out=None, check=True, impacts=True):
+          passes=1, iteration="repeat", warm=None, schedule=None, out=None, check=True, impacts=True):
     """Resolves every contact in place; returns ``(J, stats)``.
 
     ``bodies.v`` and ``bodies.w`` are updated; J (shape (3, M), the dtype of
     the scene) is the impulse on body a of each contact. ``stats`` has the keys
     of ``collide solve --stats`` (collisions, impacts, bodies, kernel_seconds,
     collisions_per_second, precision, threads, model, path, isa, isa_choice,
-    layout, accuracy, lanes, order, passes, iteration, residual, batches,
+    layout, accuracy, lanes, order, passes, iteration, warm_start, residual, batches,
     largest_batch, colours,
     overflow_contacts, schedule_seconds, isa_calibration_seconds,
     allocate_seconds; kernel_seconds is the solve less its ISA measurement
@@ -153,7 +153,13 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     "accumulate" (each contact's total impulse moved towards rest and clamped,
     restitution once, J the totals: how physics engines iterate; fast
     accuracy only); ``stats["residual"]`` is the last pass's largest change
-    of a J over the largest |J| (docs/collision-law.md, "Iteration"). No array the solve writes (v, w
+    of a J over the largest |J| (docs/collision-law.md, "Iteration"). ``warm``
+    (shape (3, M), the scene's dtype; with iteration="accumulate") is a warm
+    start: the J of a solve before, of the same contacts in the same places
+    (the previous frame's), which the passes start from instead of zero
+    (docs/collision-law.md, "The warm start"); it may be ``out`` itself,
+    and a J that is not finite or has J . n < 0 is refused (ValueError
+    naming ``warm[:, k]``). No array the solve writes (v, w
     or the records, and ``out``) may share memory with another of its arrays
     (ValueError naming both). For frame loops build a
     :class:`Solver` and a :class:`Schedule` once. The GIL is released while
@@ -177,25 +183,27 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     pass costs 5 to 10% of a particle solve.
     """
     solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy, order=order, passes=passes,
-                    iteration=iteration)
-    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, check=check, impacts=impacts)
+                    iteration=iteration, warm_start=warm is not None)
+    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, warm=warm, check=check,
+                        impacts=impacts)
 
 
-def reference_solve(bodies, contacts, *, order="input", passes=1, iteration="repeat", schedule=None):
+def reference_solve(bodies, contacts, *, order="input", passes=1, iteration="repeat", warm=None, schedule=None):
     """The high-precision reference (long double) on an exact copy of the inputs.
 
     The caller's bodies are not modified. Returns a :class:`Reference` with
     ``J`` (float64 (3, M)), the bodies' ``v`` and ``w`` after it, and
     ``impulse_scale`` per contact. Call it before :func:`solve` (which
     updates the velocities) to compare the two with :func:`impulse_error`,
-    with the solve's ``order``, ``passes`` and ``iteration`` (or its ``schedule``): the
-    reference applies the law in the same sequence. Packed bodies are
+    with the solve's ``order``, ``passes``, ``iteration`` and ``warm`` (or its
+    ``schedule``): the reference applies the law in the same sequence, from
+    the same warm start. Packed bodies are
     unpacked first (an exact copy).
     """
     if isinstance(bodies, PackedBodies):
         bodies = bodies.unpack()
     return _collide.reference_solve(bodies, contacts, order=order, passes=passes, iteration=iteration,
-                                    schedule=schedule)
+                                    schedule=schedule, warm=warm)
 
 
 def impulse_error(J, reference):

@@ -36,8 +36,11 @@
 
 #include <atomic>
 #include <chrono>
+#include <iomanip>
+#include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <variant>
@@ -52,6 +55,7 @@
 #include "collide/eval/reference.hpp"
 #include "collide/io/scene.hpp"
 #include "collide/isa.hpp"
+#include "collide/validate.hpp"
 #include "interrupt.hpp"
 #include "packed_bodies.hpp"
 #include "scene.hpp"
@@ -75,7 +79,7 @@ int passes_argument(const py::object& passes) {
 
 SolverOptions solver_options(const std::string& path, const py::object& threads, const py::object& isa,
                              const std::string& accuracy, const std::string& order, const py::object& passes,
-                             const std::string& iteration) {
+                             const std::string& iteration, bool warm_start) {
   SolverOptions o;
   o.order = parse_order(order);
   o.passes = passes_argument(passes);
@@ -93,6 +97,12 @@ SolverOptions solver_options(const std::string& path, const py::object& threads,
   if (o.iteration == Iteration::accumulate && o.accuracy == Accuracy::accurate) {
     throw py::value_error("iteration='accumulate' runs in the fast mode: it takes accuracy='fast'");
   }
+  if (warm_start && o.iteration != Iteration::accumulate) {
+    throw py::value_error(
+        "a warm start needs iteration='accumulate' (the repeat mode's passes add impulses and cannot start from a "
+        "J)");
+  }
+  o.warm_start = warm_start;
   return o;
 }
 
@@ -158,9 +168,9 @@ struct PySolver {
   std::unique_ptr<Solver> solver;
 
   PySolver(const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
-           const std::string& order, const py::object& passes, const std::string& iteration)
+           const std::string& order, const py::object& passes, const std::string& iteration, bool warm_start)
       : solver(std::make_unique<Solver>(
-            stoppable(solver_options(path, threads, isa, accuracy, order, passes, iteration)))) {}
+            stoppable(solver_options(path, threads, isa, accuracy, order, passes, iteration, warm_start)))) {}
 
   SolverOptions stoppable(SolverOptions o) const {
     o.stop = stop.get();
@@ -169,9 +179,23 @@ struct PySolver {
 
   template <class T, class B>
   py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
-                    const py::object& out, bool check, bool impacts) {
+                    const py::object& out, const py::object& warm, bool check, bool impacts) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
+    const bool warm_start = solver->options().warm_start;
+    if (warm.is_none() == warm_start) {
+      throw py::value_error(warm_start ? "solve: this Solver was built with warm_start=True and takes warm=, the J to "
+                                         "start from (zeros for a first frame)"
+                                       : "solve: warm= needs a Solver built with warm_start=True (collide.solve "
+                                         "builds one when it is given warm=)");
+    }
+    // The warm start is J on entry: `out` itself, or copied into it below.
+    py::array w;
+    if (warm_start) {
+      w = checked_array("solve", "warm", warm, numpy_dtype(bodies.dtype), dtype_name(bodies.dtype), 3, false);
+      require_length("solve", "warm", w, contacts.count, "contacts.a");
+    }
+    const bool warm_is_out = warm_start && w.ptr() == j.ptr();
     {
       // What the solve writes (v and w or the records, J) shares no memory
       // with what it reads or writes besides: checked with check=False too.
@@ -179,6 +203,7 @@ struct PySolver {
       add_bytes(arrays, bodies);
       add_bytes(arrays, contacts);
       add_bytes(arrays, "solve", "out", j, true);
+      if (warm_start && !warm_is_out) add_bytes(arrays, "solve", "warm", w, false);
       require_disjoint(arrays);
     }
     const ImpulseView<T> jv{contacts.count, vec3<T>(j)};  // rows one stride apart, as checked_array allows
@@ -211,6 +236,19 @@ struct PySolver {
                             "': build it as collide.Schedule(bodies, contacts, order=\"" + order + "\")");
     }
     const Model model = solve_model<T>(bodies, cv, requested, check);
+    if (warm_start) {
+      if (!warm_is_out) j[py::ellipsis()] = w;
+      if (check) {
+        const ImpulseView<const T> wv{jv.count, {jv.j.x, jv.j.y, jv.j.z}};
+        if (const std::size_t k = first_refused_warm_start(cv, wv); k < cv.count) {
+          std::ostringstream value;
+          value << std::setprecision(std::numeric_limits<T>::max_digits10) << "(" << wv.j.x[k] << ", " << wv.j.y[k]
+                << ", " << wv.j.z[k] << ")";
+          throw py::value_error("solve: warm[:, " + std::to_string(k) + "] = " + value.str() + " " +
+                                warm_start_refusal(cv, wv, k));
+        }
+      }
+    }
     SolveStats stats;
     double kernel_seconds = 0;
     {
@@ -238,10 +276,10 @@ struct PySolver {
 
   template <class B>
   py::tuple solve(const B& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
-                  const py::object& out, bool check, bool impacts) {
+                  const py::object& out, const py::object& warm, bool check, bool impacts) {
     require_same_dtype(bodies, contacts);
     return with_dtype(bodies.dtype, [&](auto tag) {
-      return solve_t<decltype(tag)>(bodies, contacts, model, schedule, out, check, impacts);
+      return solve_t<decltype(tag)>(bodies, contacts, model, schedule, out, warm, check, impacts);
     });
   }
 };
@@ -290,7 +328,7 @@ struct Reference {
 
 std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const std::string& order,
                                               const py::object& passes_in, const std::string& iteration_name,
-                                              const PySchedule* schedule) {
+                                              const PySchedule* schedule, const py::object& warm) {
   require_same_dtype(bodies, contacts);
   const int passes = passes_argument(passes_in);
   const Iteration iteration = parse_iteration(iteration_name);
@@ -308,7 +346,19 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
                             " contacts and " + std::to_string(schedule->bodies) + " bodies, not " +
                             std::to_string(contacts.count) + " and " + std::to_string(bodies.count));
     }
-    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes), iteration};
+    const bool warm_start = !warm.is_none();
+    if (warm_start && iteration != Iteration::accumulate) {
+      throw py::value_error(
+          "reference_solve: a warm start needs iteration='accumulate' (the repeat mode's passes add impulses and "
+          "cannot start from a J)");
+    }
+    py::array w;
+    if (warm_start) {
+      w = checked_array("reference_solve", "warm", warm, numpy_dtype(bodies.dtype), dtype_name(bodies.dtype), 3, false);
+      require_length("reference_solve", "warm", w, contacts.count, "contacts.a");
+    }
+    const Vec3Array<T> wrows = warm_start ? vec3<T>(w) : Vec3Array<T>{};
+    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes), iteration, warm_start};
     auto r = std::make_shared<Reference>();
     r->dtype = bodies.dtype;
     const BodyView<T> bv = bodies.view<T>();
@@ -317,6 +367,14 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
     r->after = convert_bodies<long double>(const_view(bv));
     const ContactBuffer<long double> lc = convert_contacts<long double>(cv);
     r->impulses.resize(contacts.count);
+    if (warm_start) {
+      const ImpulseView<long double> to = r->impulses.view();
+      for (std::size_t k = 0; k < contacts.count; ++k) {
+        to.j.x[k] = wrows.x[k];
+        to.j.y[k] = wrows.y[k];
+        to.j.z[k] = wrows.z[k];
+      }
+    }
     r->diagnostics.resize(contacts.count);
     r->before_totals = momentum_totals<long double>(std::as_const(r->after).view());
     reference_solve<long double>(r->after.view(), lc.view(), r->impulses.view(), r->diagnostics.data(), sequence);
@@ -418,10 +476,10 @@ void register_solve(py::module_& m) {
 
   py::class_<PySolver>(m, "Solver")
       .def(py::init<const std::string&, const py::object&, const py::object&, const std::string&, const std::string&,
-                    const py::object&, const std::string&>(),
+                    const py::object&, const std::string&, bool>(),
            py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
            py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1,
-           py::arg("iteration") = "repeat")
+           py::arg("iteration") = "repeat", py::arg("warm_start") = false)
       .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return to_string(s.solver->isa()); })
@@ -429,20 +487,22 @@ void register_solve(py::module_& m) {
       .def_property_readonly("order", [](const PySolver& s) { return to_string(s.solver->options().order); })
       .def_property_readonly("passes", [](const PySolver& s) { return s.solver->options().passes; })
       .def_property_readonly("iteration", [](const PySolver& s) { return to_string(s.solver->options().iteration); })
+      .def_property_readonly("warm_start", [](const PySolver& s) { return s.solver->options().warm_start; })
       .def("__repr__",
            [](const PySolver& s) {
              const SolverOptions& o = s.solver->options();
              return std::string("collide.Solver(path='") + to_string(o.path) +
                     "', threads=" + std::to_string(o.threads) + ", isa='" + to_string(s.solver->isa()) +
                     "', accuracy='" + to_string(o.accuracy) + "', order='" + to_string(o.order) +
-                    "', passes=" + std::to_string(o.passes) + ", iteration='" + to_string(o.iteration) + "')";
+                    "', passes=" + std::to_string(o.passes) + ", iteration='" + to_string(o.iteration) + "'" +
+                    (o.warm_start ? ", warm_start=True" : "") + ")";
            })
       .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
-           py::arg("check") = true, py::arg("impacts") = true)
+           py::arg("warm") = py::none(), py::arg("check") = true, py::arg("impacts") = true)
       .def("solve", &PySolver::solve<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
-           py::arg("check") = true, py::arg("impacts") = true);
+           py::arg("warm") = py::none(), py::arg("check") = true, py::arg("impacts") = true);
 
   py::class_<ThreadLimit>(m, "ThreadLimit")
       .def(py::init<int>(), py::arg("threads"))
@@ -475,8 +535,8 @@ void register_solve(py::module_& m) {
   m.def(
       "solve_options",
       [](const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
-         const std::string& order, const py::object& passes, const std::string& iteration) {
-        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes, iteration);
+         const std::string& order, const py::object& passes, const std::string& iteration, bool warm_start) {
+        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes, iteration, warm_start);
         py::dict d;
         d["path"] = to_string(o.path);
         d["threads"] = o.threads;
@@ -485,13 +545,15 @@ void register_solve(py::module_& m) {
         d["order"] = to_string(o.order);
         d["passes"] = o.passes;
         d["iteration"] = to_string(o.iteration);
+        d["warm_start"] = o.warm_start;
         return d;
       },
       py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
-      py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat");
+      py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat",
+      py::arg("warm_start") = false);
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
         py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat",
-        py::arg("schedule") = nullptr);
+        py::arg("schedule") = nullptr, py::arg("warm") = py::none());
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("conservation_drift", &conservation_drift_py, py::arg("bodies"), py::arg("reference"));
   m.attr("accurate_error_ulps") = kAccurateErrorUlps;

@@ -111,6 +111,7 @@ TEST(Check, ImpactsAndRecord) {
                                              "order",
                                              "passes",
                                              "iteration",
+                                             "warm_start",
                                              "residual",
                                              "batches",
                                              "largest_batch",

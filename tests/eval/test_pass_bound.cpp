@@ -5,7 +5,8 @@
 // ----------------
 // * The bound can fail at every pass count: on a pile, a chain and debris
 //   (with and without friction), in the input order and the colour order, at
-//   1, 4 and 16 passes, in both iteration modes (repeat and accumulate), the
+//   1, 4 and 16 passes, in both iteration modes (repeat and accumulate), and
+//   at 1 and 4 accumulated passes warm-started from an earlier solve's J, the
 //   solve's J is within the bound, while the same J made 1% larger, or all
 //   zero, is not.
 // * The scale of a pass sum stays of the size of the impulses summed: a 1%
@@ -62,12 +63,13 @@ struct Case {
   Order order;
   int passes;
   Iteration iteration;
+  bool warm = false;  ///< started from the J of 8 accumulated passes on the same input
 };
 
 std::string case_name(const testing::TestParamInfo<Case>& info) {
   const Case& c = info.param;
   return std::string(name(c.kind)) + (c.friction ? "_friction_" : "_") + to_string(c.order) + "_passes_" +
-         std::to_string(c.passes) + "_" + to_string(c.iteration);
+         std::to_string(c.passes) + "_" + to_string(c.iteration) + (c.warm ? "_warm" : "");
 }
 
 class PassBound : public testing::TestWithParam<Case> {};
@@ -88,13 +90,28 @@ TEST_P(PassBound, HoldsForTheSolveAndFailsForAWrongJ) {
   o.iteration = param.iteration;
   o.threads = 2;
   ImpulseBuffer<float> j(contacts.count);
+  ImpulseBuffer<long double> ref_j(contacts.count);
+  if (param.warm) {
+    // The warm start: J of an earlier solve of the same input, in both.
+    BodyBuffer<float> earlier = scene.bodies;
+    SolverOptions e = o;
+    e.passes = 8;
+    Solver(e).solve(earlier.view(), contacts, j.view(), schedule);
+    const ImpulseView<float> from = j.view();
+    const ImpulseView<long double> to = ref_j.view();
+    for (std::size_t k = 0; k < contacts.count; ++k) {
+      to.j.x[k] = from.j.x[k];
+      to.j.y[k] = from.j.y[k];
+      to.j.z[k] = from.j.z[k];
+    }
+    o.warm_start = true;
+  }
   Solver(o).solve(bodies.view(), contacts, j.view(), schedule);
 
-  ImpulseBuffer<long double> ref_j(contacts.count);
   std::vector<ReferenceContact<long double>> diag(contacts.count);
   reference_solve<long double>(
       ref_bodies.view(), ref_contacts.view(), ref_j.view(), diag.data(),
-      SolveSequence{schedule.order(), static_cast<std::size_t>(param.passes), param.iteration});
+      SolveSequence{schedule.order(), static_cast<std::size_t>(param.passes), param.iteration, param.warm});
   const ImpulseView<const long double> ref = std::as_const(ref_j).view();
 
   const ImpulseCheck solved = check_impulses<float>(std::as_const(j).view(), ref, diag);
@@ -145,6 +162,7 @@ std::vector<Case> cases() {
           all.push_back({kind, friction, order, passes, iteration});
         }
       }
+      for (const int passes : {1, 4}) all.push_back({kind, friction, order, passes, Iteration::accumulate, true});
     }
   }
   return all;

@@ -65,6 +65,20 @@ struct SolverOptions {
   /// solve either way, bit for bit. Iteration::accumulate runs in the fast
   /// mode (the constructor refuses it with Accuracy::accurate).
   Iteration iteration = Iteration::repeat;
+  /// The impulse arrays hold a warm start on entry: each contact's J from a
+  /// solve before (the previous frame's, of the same contacts in the same
+  /// places; which contact is which across frames is the caller's to keep,
+  /// as in every engine). The accumulated passes start from it: the first
+  /// pass applies it to the bodies, then moves it as a later pass moves its
+  /// totals, so resting contacts start near their answer
+  /// (docs/collision-law.md, "The warm start"). Only the normal part of J is
+  /// kept for a contact with mu = 0, and none for one without a movable
+  /// body. Needs Iteration::accumulate (the constructor refuses it
+  /// otherwise). Each J must be finite with J . n >= 0 (n the contact's
+  /// normal, to rounding): Solver::solve checks it in every build type
+  /// before anything is written, and throws std::invalid_argument naming
+  /// the contact.
+  bool warm_start = false;
   /// A flag the solve's threads read between passes, never inside one: once
   /// it reads true, a solve ends with the pass in progress, v, w and J as
   /// the passes done left them (SolveStats::passes says how many). For a
@@ -117,6 +131,7 @@ struct SolveStats {
   /// ended the solve (at least 1).
   std::size_t passes = 1;
   Iteration iteration = Iteration::repeat;  ///< SolverOptions::iteration
+  bool warm_start = false;                  ///< SolverOptions::warm_start: the passes started from the given J
   /// How far the passes are from converged: the largest change of a
   /// contact's J in the last pass, |J - J before the last pass|, over the
   /// largest |J| (docs/collision-law.md, "The residual"); 0 when every J is

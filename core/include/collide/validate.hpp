@@ -97,4 +97,24 @@ bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count
 
 Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count);
 
+/// A warm start's J (SolverOptions::warm_start) a solve takes: finite, and
+/// J . n >= 0 to within the fast mode's error bound of rounding
+/// (kImpulseErrorBoundEps eps(T) |J| |n|: the J a solve wrote rounds no
+/// further), since a normal impulse never pulls its bodies together.
+/// Solver::solve checks every contact's this way before writing anything.
+template <class T>
+bool warm_start_accepted(const T (&j)[3], const T (&n)[3]);
+
+/// The first contact (by index) whose J in `warm` warm_start_accepted
+/// refuses, or contacts.count when there is none. O(count), one thread:
+/// for callers that name the contact in their own terms before solving.
+template <class T>
+std::size_t first_refused_warm_start(const ContactView<T>& contacts, const ImpulseView<const T>& warm);
+
+/// Why contact k's J in `warm` is refused, as a phrase that follows the
+/// value: "is not finite", or "has J . n = -0.5 < 0: a normal impulse never
+/// pulls the bodies together".
+template <class T>
+std::string warm_start_refusal(const ContactView<T>& contacts, const ImpulseView<const T>& warm, std::size_t k);
+
 }  // namespace collide

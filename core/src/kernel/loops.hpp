@@ -385,7 +385,9 @@ COLLIDE_LANE_INLINE void store_accumulated(const AccumulatedView<T>& view, const
 
 /// One accumulated pass of one group of V::size() contacts (KernelJob::
 /// accumulates): the first pass's law recording the totals, or a later
-/// pass moving them; J is written, not added.
+/// pass moving them; J is written, not added. A warm start's visits
+/// (KernelJob::warm with first_pass) measure the targets, then apply the
+/// totals, and write no J.
 template <class M, class V, bool kFriction, class T, class View>
 COLLIDE_LANE_INLINE void accumulate_group(const View& bodies, const KernelJob<T>& job, const ContactGroup& g) {
   const GroupBodies<V::size()> at = group_bodies<V>(bodies, job.contacts, g);
@@ -401,6 +403,18 @@ COLLIDE_LANE_INLINE void accumulate_group(const View& bodies, const KernelJob<T>
   c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
   if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
   Accumulated<V> acc;
+  if (job.first_pass && job.warm != WarmVisit::none) {
+    acc = load_accumulated<V, kFriction>(job.accumulated, g);
+    const ContactGeometry<V> geo = contact_geometry(a, b, c);
+    if (job.warm == WarmVisit::targets) {
+      warm_start_target(a, b, c, geo, acc);
+    } else {
+      warm_start_step<M, V, kFriction>(a, b, c, geo, acc);
+      store_group_bodies<M, V, T>(bodies, at, a, b);
+    }
+    store_accumulated<V, kFriction>(job.accumulated, g, acc);
+    return;
+  }
   ContactResult<V> r;
   if (job.first_pass) {
     r = first_accumulated_pass<M, V, kFriction>(a, b, c, acc);
@@ -475,6 +489,17 @@ COLLIDE_LANE_INLINE void accumulate_step_group(const View& bodies, const KernelJ
   c.n = {load<V>(contacts.n.x + first), load<V>(contacts.n.y + first), load<V>(contacts.n.z + first)};
   c.e = contacts.e ? load<V>(contacts.e + first) : V(contacts.uniform_e);
   Accumulated<V> acc;
+  if (job.first_pass && job.warm != WarmVisit::none) {
+    acc = load_accumulated<V, false>(job.accumulated, g);
+    if (job.warm == WarmVisit::targets) {
+      warm_start_target(a, b, c, geo, acc);
+    } else {
+      warm_start_step<M, V, false>(a, b, c, geo, acc);
+      store_group_bodies<M, V, T>(bodies, at, a, b);
+    }
+    store_accumulated<V, false>(job.accumulated, g, acc);
+    return;
+  }
   ContactResult<V> r;
   if (job.first_pass) {
     r = first_accumulated_step<M, V, false>(a, b, c, geo, acc);

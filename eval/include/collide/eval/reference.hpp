@@ -61,6 +61,9 @@ struct SolveSequence {
   const std::uint32_t* order = nullptr;
   std::size_t passes = 1;
   Iteration iteration = Iteration::repeat;
+  /// The impulse arrays hold a warm start on entry (SolverOptions::
+  /// warm_start; Iteration::accumulate): the first pass starts from it.
+  bool warm_start = false;
 };
 
 /// Applies the law to every contact in `sequence` (input order by default).
