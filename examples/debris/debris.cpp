@@ -99,6 +99,10 @@ void usage(const char* argv0) {
       "  --e E            restitution in [0, 1] (default 0.3)\n"
       "  --mu MU          friction coefficient (default 0.5)\n"
       "  --passes N       solver passes per step (default 3)\n"
+      "  --iteration I    what the passes after the first do: repeat (default: the law again)\n"
+      "                   or accumulate (each contact's total impulse moved and clamped)\n"
+      "  --warm-start     start each step's accumulated passes from the last step's impulse\n"
+      "                   of the same two bodies (needs --iteration accumulate)\n"
       "  --order O        input, colour or both (default: both, the same world once in each\n"
       "                   solve order, the figures of each side by side)\n"
       "  --threads N      worker threads, 0 = all (default 0)\n"
@@ -118,6 +122,10 @@ bool parse(int argc, char** argv, Options& o) {
     const std::string arg = argv[i];
     if (arg == "--check") {
       o.check = true;
+      continue;
+    }
+    if (arg == "--warm-start") {
+      o.warm_start = true;
       continue;
     }
     if (arg == "--help" || arg == "-h") return false;
@@ -140,6 +148,8 @@ bool parse(int argc, char** argv, Options& o) {
       o.friction = std::atof(value);
     } else if (arg == "--passes") {
       o.passes = std::atoi(value);
+    } else if (arg == "--iteration") {
+      o.iteration = value;
     } else if (arg == "--order") {
       o.order = value;
     } else if (arg == "--threads") {
@@ -157,7 +167,8 @@ bool parse(int argc, char** argv, Options& o) {
   }
   if (o.spheres < 0 || o.particles < 0 || o.spheres + o.particles == 0 || o.steps < 1 || !(o.dt > 0) || o.passes < 1 ||
       !(o.restitution >= 0 && o.restitution <= 1) || !(o.friction >= 0) || o.threads < 0 ||
-      (o.order != "input" && o.order != "colour" && o.order != "both")) {
+      (o.order != "input" && o.order != "colour" && o.order != "both") ||
+      (o.iteration != "repeat" && o.iteration != "accumulate") || (o.warm_start && o.iteration != "accumulate")) {
     std::fprintf(stderr, "bad option value\n");
     return false;
   }
@@ -171,6 +182,9 @@ RunSummary simulate(const Options& o, collide::Order order, const std::string& p
 
   RunSummary r;
   r.order = order;
+  r.iteration = o.iteration;
+  r.warm_start = o.warm_start;
+  r.passes = o.passes;
   const Energy e0 = energy(world);
   r.e0 = e0.total();
   r.max_total = r.e0;

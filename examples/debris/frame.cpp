@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 
 namespace debris {
 namespace {
@@ -47,7 +48,13 @@ collide::SolverOptions make_solver_options(const Options& o, collide::Order orde
   solver_options.threads = o.threads;
   solver_options.order = order;
   solver_options.passes = o.passes;  // the passes of a step share its schedule
+  solver_options.iteration = o.iteration == "accumulate" ? collide::Iteration::accumulate : collide::Iteration::repeat;
+  solver_options.warm_start = o.warm_start;
   return solver_options;
+}
+
+std::uint64_t pair_key(collide::BodyIndex a, collide::BodyIndex b) {
+  return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint64_t>(b);
 }
 
 }  // namespace
@@ -65,6 +72,18 @@ StepFigures Frame::step(World& world) {
   const collide::ContactView<Real> view = contacts_.view(o.restitution);
   const collide::ImpulseView<Real> impulses = contacts_.impulses();
   const collide::PackedView<Body> bodies = world.view();
+  if (o.warm_start) {
+    // The warm start: each contact's J from the last step's contact of the
+    // same two bodies, 0 for a pair that just met.
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      const auto it = last_j_.find(pair_key(contacts_.a[k], contacts_.b[k]));
+      const bool found = it != last_j_.end();
+      contacts_.jx[k] = found ? it->second[0] : Real(0);
+      contacts_.jy[k] = found ? it->second[1] : Real(0);
+      contacts_.jz[k] = found ? it->second[2] : Real(0);
+      f.warm += found ? 1 : 0;
+    }
+  }
 
   // collide: one schedule for this step's contacts, several passes over
   // it in one solve, each writing v and w into the records in place.
@@ -72,9 +91,16 @@ StepFigures Frame::step(World& world) {
   schedule_.build(view, bodies);  // inverse masses read from the records
   f.stats = solver_.solve(bodies, view, impulses, schedule_);
   f.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - s0).count();
-  // J sums the passes: the contacts that got an impulse in some pass.
+  // J sums the passes (or is each contact's total): the contacts that got
+  // an impulse in some pass.
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     f.resolved += contacts_.jx[k] != 0 || contacts_.jy[k] != 0 || contacts_.jz[k] != 0 ? 1 : 0;
+  }
+  if (o.warm_start) {
+    last_j_.clear();
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      last_j_[pair_key(contacts_.a[k], contacts_.b[k])] = {contacts_.jx[k], contacts_.jy[k], contacts_.jz[k]};
+    }
   }
 
   double max_depth = 0, sum_depth = 0;

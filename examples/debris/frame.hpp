@@ -12,7 +12,10 @@
 //   show it.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
+#include <unordered_map>
 
 #include <collide/schedule.hpp>
 #include <collide/solve.hpp>
@@ -26,6 +29,7 @@ namespace debris {
 /// What one step leaves for the run's figures.
 struct StepFigures {
   std::size_t resolved = 0;              // contacts that got an impulse (J != 0) in some pass
+  std::size_t warm = 0;                  // contacts warm-started from the last step's J
   double max_depth = 0, mean_depth = 0;  // [m] this step's overlaps, before the position correction
   double lifted = 0;                     // [J] potential energy the position correction added
   double solve_seconds = 0;              // schedule.build and solver.solve
@@ -50,6 +54,10 @@ class Frame {
   UniformGrid grid_;
   collide::Schedule schedule_;  // rebuilt every step; keeps its buffers
   collide::Solver solver_;      // one thread pool for the whole run
+  /// The last step's J by pair of bodies (a << 32 | b), for the warm start:
+  /// which contact is which across steps is the simulation's to keep, and
+  /// here a pair of bodies touches at most once.
+  std::unordered_map<std::uint64_t, std::array<Real, 3>> last_j_;
 };
 
 }  // namespace debris

@@ -18,9 +18,11 @@ struct Options {
   double restitution = 0.3;
   double friction = 0.5;
   int passes = 3;
-  std::string order = "both";  // input, colour, or both one after the other
-  int threads = 0;             // 0: every hardware thread
-  int every = 1;               // print every n-th step
+  std::string iteration = "repeat";  // repeat or accumulate (collide::Iteration)
+  bool warm_start = false;           // accumulate from the last step's J of the same pair of bodies
+  std::string order = "both";        // input, colour, or both one after the other
+  int threads = 0;                   // 0: every hardware thread
+  int every = 1;                     // print every n-th step
   std::uint64_t seed = 1;
   std::string out;  // PNG path; empty: no picture
   bool check = false;

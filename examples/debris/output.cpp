@@ -55,9 +55,18 @@ bool write_png(const std::string& path, const std::vector<StepRecord>& history, 
 
 }  // namespace
 
+namespace {
+/// How the passes iterate, as the run header says it.
+const char* iteration_name(const Options& o) {
+  if (o.iteration != "accumulate") return "";
+  return o.warm_start ? ", accumulated, warm-started" : ", accumulated";
+}
+}  // namespace
+
 void print_run_header(const Options& o, collide::Order order) {
-  std::printf("\n%s order: %d spheres + %d particles on a ground, dt = %g s, e = %g, mu = %g, %d passes\n",
-              collide::to_string(order), o.spheres, o.particles, o.dt, o.restitution, o.friction, o.passes);
+  std::printf("\n%s order: %d spheres + %d particles on a ground, dt = %g s, e = %g, mu = %g, %d passes%s\n",
+              collide::to_string(order), o.spheres, o.particles, o.dt, o.restitution, o.friction, o.passes,
+              iteration_name(o));
   std::printf("%5s %6s %10s %10s %10s %7s %7s %7s %8s %7s %9s %7s %7s\n", "step", "t[s]", "E_kin[J]", "E_pot[J]",
               "E_tot[J]", "contact", "ground", "pairs", "resolved", "batches", "conflicts", "pen[mm]", "ms");
 }
@@ -91,11 +100,12 @@ void write_picture(const std::string& png, const std::vector<StepRecord>& histor
 }
 
 void print_orders(const std::vector<RunSummary>& runs) {
-  std::printf("\n%-7s %14s %14s %13s %13s %12s %12s\n", "order", "E_end[J]", "E_highest[J]", "pen_max[mm]",
-              "pen_mean[mm]", "contacts", "M solves/s");
+  std::printf("\n%-7s %-16s %6s %14s %14s %13s %13s %12s %12s\n", "order", "iteration", "passes", "E_end[J]",
+              "E_highest[J]", "pen_max[mm]", "pen_mean[mm]", "contacts", "M solves/s");
   for (const RunSummary& r : runs) {
-    std::printf("%-7s %14.3f %14.3f %13.3f %13.3f %12zu %12.1f\n", collide::to_string(r.order), r.e_end, r.max_total,
-                1000 * r.final_max_depth, 1000 * r.final_mean_depth, r.final_contacts,
+    const char* iteration = r.iteration != "accumulate" ? "repeat" : r.warm_start ? "accumulate+warm" : "accumulate";
+    std::printf("%-7s %-16s %6d %14.3f %14.3f %13.3f %13.3f %12zu %12.1f\n", collide::to_string(r.order), iteration,
+                r.passes, r.e_end, r.max_total, 1000 * r.final_max_depth, 1000 * r.final_mean_depth, r.final_contacts,
                 r.solved_contacts / std::max(r.solve_seconds, 1e-9) / 1e6);
   }
 }

@@ -33,6 +33,9 @@ struct StepRecord {
 /// What a run leaves for the comparison of the orders and for --check.
 struct RunSummary {
   collide::Order order = collide::Order::input;
+  std::string iteration = "repeat";  // Options::iteration of the run
+  bool warm_start = false;
+  int passes = 1;
   double e0 = 0, e_end = 0, max_total = 0, lifted = 0, max_excess = 0;
   std::size_t max_contacts = 0, max_resolved = 0, final_contacts = 0;
   double final_max_depth = 0, final_mean_depth = 0;  // [m] the resting pile's overlaps after the last step
