@@ -218,6 +218,14 @@ void register_rows(const Options& options, std::size_t file_contacts) {
                       [=](benchmark::State& s) { order_row<float>(s, kind, size, order, passes, 2, iteration); });
             }
           }
+          // Warm-started from a converged J of the same input: what a frame
+          // loop's resting contacts cost.
+          for (const int passes : {1, 2}) {
+            add_row(iterate_name(kind, "f32", order, collide::Iteration::accumulate, passes, 2, size, true),
+                    [=](benchmark::State& s) {
+                      order_row<float>(s, kind, size, order, passes, 2, collide::Iteration::accumulate, true);
+                    });
+          }
         }
         // The order's memory-only twin: the ceiling of its index pattern.
         add_row(order_twin_name(kind, "f32", order, 2, size),

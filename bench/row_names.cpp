@@ -71,9 +71,10 @@ std::string order_name(Kind kind, const char* precision, collide::Order order, i
 }
 
 std::string iterate_name(Kind kind, const char* precision, collide::Order order, collide::Iteration iteration,
-                         int passes, int threads, std::size_t n) {
+                         int passes, int threads, std::size_t n, bool warm) {
   return std::string("iterate/") + kind_name(kind) + "/" + precision + "/" + collide::to_string(order) + "/" +
-         collide::to_string(iteration) + "/passes:" + std::to_string(passes) + threads_and_n(threads, n);
+         collide::to_string(iteration) + (warm ? "/warm" : "") + "/passes:" + std::to_string(passes) +
+         threads_and_n(threads, n);
 }
 
 std::string order_twin_name(Kind kind, const char* precision, collide::Order order, int threads, std::size_t n) {

@@ -61,8 +61,9 @@ std::string schedule_name(Kind kind, const char* precision, std::size_t n,
 std::string order_name(Kind kind, const char* precision, collide::Order order, int passes, int threads, std::size_t n);
 /// The iteration modes of an order's passes side by side: per pass, and the
 /// residual in the label.
+/// A warm-started row has "/warm" after the iteration mode.
 std::string iterate_name(Kind kind, const char* precision, collide::Order order, collide::Iteration iteration,
-                         int passes, int threads, std::size_t n);
+                         int passes, int threads, std::size_t n, bool warm = false);
 std::string order_twin_name(Kind kind, const char* precision, collide::Order order, int threads, std::size_t n);
 
 }  // namespace collide_bench

@@ -28,6 +28,7 @@
 
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <type_traits>
@@ -288,7 +289,7 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
 
 template <class T>
 void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads,
-               collide::Iteration iteration) {
+               collide::Iteration iteration, bool warm) {
   Prepared<T>& p = prepared_scene<T>(kind, n);
   measure_isa_auto<T>(collide::Model::rigid);
   collide::SolverOptions options;
@@ -296,15 +297,34 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   options.order = order;
   options.passes = passes;
   options.iteration = iteration;
+  options.warm_start = warm;
   const collide::Solver solver(options);
   collide::Schedule schedule(order);  // untimed: a schedule serves every frame while the contacts hold
   const collide::BodyView<T> bodies = p.bodies();
   const collide::ContactView<T> contacts = p.contacts();
   const collide::ImpulseView<T> impulses = p.impulses.view();
   schedule.build(contacts, bodies, threads);
+  // The warm start: a converged J of the same input, the bodies as they were.
+  collide::ImpulseBuffer<T> start;
+  if (warm) {
+    collide::SolverOptions converge = options;
+    converge.passes = 64;
+    converge.warm_start = false;
+    start.resize(contacts.count);
+    (void)collide::Solver(converge).solve(bodies, contacts, start.view(), schedule);
+    p.restore();
+  }
+  const auto copy_start = [&] {
+    if (!warm) return;
+    const collide::ImpulseView<const T> from = std::as_const(start).view();
+    std::copy(from.j.x, from.j.x + from.count, impulses.j.x);
+    std::copy(from.j.y, from.j.y + from.count, impulses.j.y);
+    std::copy(from.j.z, from.j.z + from.count, impulses.j.z);
+  };
   // The warm-up sizes the solver's buffers (packing), as a frame loop's first frame does.
   collide::SolveStats stats;
-  const double seconds = timed_solves(state, p, [&] { stats = solver.solve(bodies, contacts, impulses, schedule); });
+  const double seconds = timed_solves(
+      state, p, [&] { stats = solver.solve(bodies, contacts, impulses, schedule); }, copy_start);
   Columns columns =
       solve_columns(n * static_cast<std::size_t>(passes), bytes_per_collision<T>(p.friction), seconds, threads);
   columns.batches = static_cast<double>(stats.batches);
@@ -313,7 +333,7 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   std::string label = std::string(collide::to_string(stats.layout)) + ", " + collide::to_string(stats.isa) + ", " +
                       std::to_string(stats.colours) + " colours, " + std::to_string(stats.overflow_contacts) +
                       " overflow";
-  if (passes > 1) {
+  if (passes > 1 || warm) {
     char residual[32];
     std::snprintf(residual, sizeof residual, ", residual %.3g", stats.residual);
     label += residual;
@@ -344,7 +364,8 @@ void order_twin_row(benchmark::State& state, Kind kind, std::size_t n, collide::
   template void packed_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Model, int);                    \
   template void textbook_row<T>(benchmark::State&, Kind, std::size_t);                                            \
   template void schedule_row<T>(benchmark::State&, Kind, std::size_t, collide::Order);                            \
-  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int, collide::Iteration); \
+  template void order_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int, int, collide::Iteration,  \
+                             bool);                                                                               \
   template void order_twin_row<T>(benchmark::State&, Kind, std::size_t, collide::Order, int);
 COLLIDE_BENCH_ROWS(float)
 COLLIDE_BENCH_ROWS(double)

@@ -49,9 +49,12 @@ void schedule_row(benchmark::State& state, Kind kind, std::size_t n, collide::Or
 
 /// order/ rows: the rigid model through Solver::solve (SIMD, Isa::automatic)
 /// in `order` with `passes` passes; the rate counts every pass's contacts.
+/// With `warm` (accumulate only), every solve starts from the J of 64
+/// accumulated passes on the same input (SolverOptions::warm_start), copied
+/// into the impulse arrays untimed before each solve.
 template <class T>
 void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order order, int passes, int threads,
-               collide::Iteration iteration = collide::Iteration::repeat);
+               collide::Iteration iteration = collide::Iteration::repeat, bool warm = false);
 /// order_twin/<scene>/f32/<order>/t:T/n:N: the packed twin walked in that
 /// order's schedule (rows.cpp).
 template <class T>

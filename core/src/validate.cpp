@@ -619,7 +619,7 @@ bool warm_start_accepted(const T (&j)[3], const T (&n)[3]) {
   };
   if (!(std::isfinite(j[0]) && std::isfinite(j[1]) && std::isfinite(j[2]))) return false;
   const double along = double(j[0]) * double(n[0]) + double(j[1]) * double(n[1]) + double(j[2]) * double(n[2]);
-  return along >= -kImpulseErrorBoundEps * double(std::numeric_limits<T>::epsilon()) * length(j) * length(n);
+  return along >= kWarmStartLeastCosine * length(j) * length(n);
 }
 
 namespace {
@@ -652,8 +652,12 @@ std::string warm_start_refusal(const ContactView<T>& contacts, const ImpulseView
   if (!(std::isfinite(j[0]) && std::isfinite(j[1]) && std::isfinite(j[2]))) return "is not finite";
   const double along = double(j[0]) * double(n[0]) + double(j[1]) * double(n[1]) + double(j[2]) * double(n[2]);
   std::ostringstream text;
-  text << std::setprecision(std::numeric_limits<T>::max_digits10) << "has J . n = " << along
-       << " < 0: a normal impulse never pulls the bodies together";
+  const double size =
+      std::sqrt(double(j[0]) * double(j[0]) + double(j[1]) * double(j[1]) + double(j[2]) * double(j[2])) *
+      std::sqrt(double(n[0]) * double(n[0]) + double(n[1]) * double(n[1]) + double(n[2]) * double(n[2]));
+  text << std::setprecision(std::numeric_limits<T>::max_digits10) << "points against the normal (J . n = " << along
+       << ", below " << kWarmStartLeastCosine << " |J| |n| = " << kWarmStartLeastCosine * size
+       << "): a normal impulse never pulls the bodies together";
   return text.str();
 }
 

@@ -74,14 +74,23 @@ StepFigures Frame::step(World& world) {
   const collide::PackedView<Body> bodies = world.view();
   if (o.warm_start) {
     // The warm start: each contact's J from the last step's contact of the
-    // same two bodies, 0 for a pair that just met.
+    // same two bodies, re-expressed about this step's normal (the normal
+    // part along it, the friction part in its tangent plane), 0 for a pair
+    // that just met.
     for (std::size_t k = 0; k < contacts_.size(); ++k) {
       const auto it = last_j_.find(pair_key(contacts_.a[k], contacts_.b[k]));
-      const bool found = it != last_j_.end();
-      contacts_.jx[k] = found ? it->second[0] : Real(0);
-      contacts_.jy[k] = found ? it->second[1] : Real(0);
-      contacts_.jz[k] = found ? it->second[2] : Real(0);
-      f.warm += found ? 1 : 0;
+      if (it == last_j_.end()) {
+        contacts_.jx[k] = contacts_.jy[k] = contacts_.jz[k] = 0;
+        continue;
+      }
+      const Real n[3] = {contacts_.nx[k], contacts_.ny[k], contacts_.nz[k]};
+      const std::array<Real, 3>& g = it->second.friction;
+      const Real along = g[0] * n[0] + g[1] * n[1] + g[2] * n[2];
+      const Real lambda = it->second.lambda;
+      contacts_.jx[k] = lambda * n[0] - (g[0] - along * n[0]);
+      contacts_.jy[k] = lambda * n[1] - (g[1] - along * n[1]);
+      contacts_.jz[k] = lambda * n[2] - (g[2] - along * n[2]);
+      ++f.warm;
     }
   }
 
@@ -99,7 +108,11 @@ StepFigures Frame::step(World& world) {
   if (o.warm_start) {
     last_j_.clear();
     for (std::size_t k = 0; k < contacts_.size(); ++k) {
-      last_j_[pair_key(contacts_.a[k], contacts_.b[k])] = {contacts_.jx[k], contacts_.jy[k], contacts_.jz[k]};
+      const Real n[3] = {contacts_.nx[k], contacts_.ny[k], contacts_.nz[k]};
+      const Real j[3] = {contacts_.jx[k], contacts_.jy[k], contacts_.jz[k]};
+      const Real lambda = std::max(j[0] * n[0] + j[1] * n[1] + j[2] * n[2], Real(0));
+      last_j_[pair_key(contacts_.a[k], contacts_.b[k])] = {
+          lambda, {lambda * n[0] - j[0], lambda * n[1] - j[1], lambda * n[2] - j[2]}};
     }
   }
 

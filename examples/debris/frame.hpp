@@ -54,10 +54,17 @@ class Frame {
   UniformGrid grid_;
   collide::Schedule schedule_;  // rebuilt every step; keeps its buffers
   collide::Solver solver_;      // one thread pool for the whole run
-  /// The last step's J by pair of bodies (a << 32 | b), for the warm start:
-  /// which contact is which across steps is the simulation's to keep, and
-  /// here a pair of bodies touches at most once.
-  std::unordered_map<std::uint64_t, std::array<Real, 3>> last_j_;
+  /// The last step's impulse by pair of bodies (a << 32 | b), for the warm
+  /// start: which contact is which across steps is the simulation's to
+  /// keep, and here a pair of bodies touches at most once. Kept as engines
+  /// keep it, apart from that step's normal: the normal part lambda and the
+  /// friction part G = lambda n - J, so that the next step's J is lambda
+  /// along its own normal, with G's part in its tangent plane.
+  struct LastImpulse {
+    Real lambda;
+    std::array<Real, 3> friction;
+  };
+  std::unordered_map<std::uint64_t, LastImpulse> last_j_;
 };
 
 }  // namespace debris

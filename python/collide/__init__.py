@@ -63,6 +63,7 @@ from ._collide import (
     accurate_error_ulps,
     error_bound_eps,
     error_target_eps,
+    warm_start_least_cosine,
 )
 
 __all__ = [
@@ -78,6 +79,7 @@ __all__ = [
     "accurate_error_ulps",
     "error_bound_eps",
     "error_target_eps",
+    "warm_start_least_cosine",
     "from_physical",
     "conservation_drift",
     "generate",
@@ -158,7 +160,9 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     start: the J of a solve before, of the same contacts in the same places
     (the previous frame's), which the passes start from instead of zero
     (docs/collision-law.md, "The warm start"); it may be ``out`` itself,
-    and a J that is not finite or has J . n < 0 is refused (ValueError
+    and a J that is not finite or points against its normal (J . n below
+    ``warm_start_least_cosine`` |J| |n|: more than 120 degrees from it) is
+    refused (ValueError
     naming ``warm[:, k]``). No array the solve writes (v, w
     or the records, and ``out``) may share memory with another of its arrays
     (ValueError naming both). For frame loops build a

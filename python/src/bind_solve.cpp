@@ -559,6 +559,7 @@ void register_solve(py::module_& m) {
   m.attr("accurate_error_ulps") = kAccurateErrorUlps;
   m.attr("error_target_eps") = kImpulseErrorTargetEps;
   m.attr("error_bound_eps") = kImpulseErrorBoundEps;
+  m.attr("warm_start_least_cosine") = kWarmStartLeastCosine;
 
   m.def(
       "simd_width",

@@ -97,11 +97,17 @@ bool contacts_pass_screen(const ContactView<T>& contacts, std::size_t body_count
 
 Validation validate_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, std::size_t body_count);
 
+/// The least cosine of the angle between a warm start's J and its contact's
+/// normal that a solve takes: J within 120 degrees of n. A J from the frame
+/// before lies in the Coulomb cone of that frame's normal, and the normal
+/// turns between frames, so J . n may come out a little below 0 and the
+/// solve takes its normal part as 0; a J that points against n, as the
+/// impulse on body b instead of a, or another contact's, is refused.
+inline constexpr double kWarmStartLeastCosine = -0.5;
+
 /// A warm start's J (SolverOptions::warm_start) a solve takes: finite, and
-/// J . n >= 0 to within the fast mode's error bound of rounding
-/// (kImpulseErrorBoundEps eps(T) |J| |n|: the J a solve wrote rounds no
-/// further), since a normal impulse never pulls its bodies together.
-/// Solver::solve checks every contact's this way before writing anything.
+/// J . n >= kWarmStartLeastCosine |J| |n|. Solver::solve checks every
+/// contact's this way before writing anything.
 template <class T>
 bool warm_start_accepted(const T (&j)[3], const T (&n)[3]);
 

@@ -84,8 +84,8 @@ def checked_warm(warm, bodies, contacts):
     """Checks ``warm``, a warm start for the scene ``bodies``, ``contacts``
     (itself checked), as collide.solve checks it, with collide.solve's
     errors: the array's type, dtype, shape and layout (TypeError), its
-    length, memory shared with what a solve writes, and every J finite with
-    J . n >= 0 to within rounding (ValueError naming ``warm[:, k]``, k the
+    length, memory shared with what a solve writes, and every J finite and
+    within 120 degrees of its normal (ValueError naming ``warm[:, k]``, k the
     contact's row in the scene). The tasks solve with check=False, so these
     are checked once, on the whole scene, where the message can name the
     scene's row and not the partition's."""
@@ -130,13 +130,13 @@ _SCREEN_BLOCK = 1 << 20
 def first_refused_warm(warm, bodies, contacts):
     """collide.solve's message for the first contact (by row) whose J in
     ``warm`` it refuses, or None. The library's rule (finite, and
-    J . n >= -error_bound_eps eps |J| |n| in double) is screened here in
-    NumPy, block by block, with half its slack, so that every J it refuses
-    is a suspect whatever the last bits of the screen's sums; each suspect,
+    J . n >= warm_start_least_cosine |J| |n| in double) is screened here in
+    NumPy, block by block, a little tighter, so that every J it refuses is a
+    suspect whatever the last bits of the screen's sums; each suspect,
     in row order, is then judged by collide.solve itself, on that contact
     alone, whose message (naming it ``warm[:, 0]``) is the scene's with its
     row put back."""
-    slack = -0.5 * collide.error_bound_eps * float(np.finfo(warm.dtype).eps)
+    slack = collide.warm_start_least_cosine * (1 - 1e-6)
     with np.errstate(all="ignore"):
         for start in range(0, warm.shape[1], _SCREEN_BLOCK):
             j = warm[:, start:start + _SCREEN_BLOCK].astype(np.float64)
