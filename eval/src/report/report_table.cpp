@@ -13,6 +13,7 @@
 // * A cache size that could not be read prints "unknown", not 0.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -189,36 +190,39 @@ std::string convergence_lines(const Report& report) {
   std::string out;
   char line[512];
   std::snprintf(line, sizeof line,
-                "\nconvergence (simd %s float, frictionless, %d threads; %zu contacts per scene: a pile of %zu^3 "
+                "\nconvergence (simd %s float, frictionless, %d thread%s; %zu contacts per scene: a pile of %zu^3 "
                 "boxes and a stack\n"
                 "  of 16-box columns, contacts top first, at rest after one step of gravity, and debris as "
                 "generated): the residual,\n"
                 "  the last pass's largest change of a J over the largest J, after each number of passes; warm: "
                 "accumulate from\n"
                 "  the converged J; ms: the median time of the first column's solve.\n",
-                first.isa.c_str(), first.threads, first.n, report.convergence_pile_side);
+                first.isa.c_str(), first.threads, first.threads == 1 ? "" : "s", first.n, report.convergence_pile_side);
   out += line;
-  out += "scene  order  mode          ms";
+  // Indented, so that no line starts with a scene's name as the rows' lines do.
+  out += "  scene  order  mode          ms";
   for (const int p : passes) out += format("%9.0f", p);
   out += "\n";
-  std::string previous;
-  for (std::size_t i = 0; i < report.convergence.size();) {
-    const ConvergenceRow& head = report.convergence[i];
-    const std::string group = head.scene + " " + head.order;
-    if (!previous.empty() && head.scene != previous) out += "\n";
-    previous = head.scene;
-    std::snprintf(line, sizeof line, "%-6s %-6s %-10s %7.2f", head.scene.c_str(), head.order.c_str(),
+  const std::vector<ConvergenceRow>& rows = report.convergence;
+  const auto same_line = [](const ConvergenceRow& x, const ConvergenceRow& y) {
+    return x.scene == y.scene && x.order == y.order && x.iteration == y.iteration && x.warm == y.warm;
+  };
+  for (std::size_t i = 0; i < rows.size();) {
+    const ConvergenceRow& head = rows[i];
+    if (i > 0 && head.scene != rows[i - 1].scene) out += "\n";
+    std::size_t end = i;
+    while (end < rows.size() && same_line(rows[end], head)) ++end;
+    std::snprintf(line, sizeof line, "  %-6s %-6s %-10s %7.2f", head.scene.c_str(), head.order.c_str(),
                   head.warm ? "warm" : head.iteration.c_str(), 1e3 * head.seconds);
     out += line;
-    std::size_t k = i;
     for (const int p : passes) {
-      const bool here = k < report.convergence.size() && report.convergence[k].passes == p &&
-                        report.convergence[k].scene + " " + report.convergence[k].order == group &&
-                        report.convergence[k].iteration == head.iteration && report.convergence[k].warm == head.warm;
-      out += here ? format("%9.2g", report.convergence[k++].residual) : std::string(9, ' ');
+      const auto it =
+          std::find_if(rows.begin() + static_cast<std::ptrdiff_t>(i), rows.begin() + static_cast<std::ptrdiff_t>(end),
+                       [p](const ConvergenceRow& c) { return c.passes == p; });
+      if (it != rows.begin() + static_cast<std::ptrdiff_t>(end)) out += format("%9.2g", it->residual);
     }
     out += "\n";
-    i = std::max(k, i + 1);
+    i = end;
   }
   out += "pile: " + passes_to_converge(report, "pile", "colour", "accumulate", false) +
          " passes (accumulate, colour) reach residual <= 0.01; warm-started: " +
