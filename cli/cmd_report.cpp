@@ -61,7 +61,7 @@ const char* const kReportUsage =
     "                  pile, a stack and debris solved with 1 to 32 passes in both\n"
     "                  orders and iteration modes, and warm-started: the residual\n"
     "                  against the time (default 188800, a pile of 40^3 boxes;\n"
-    "                  --quick: at most 1408)\n"
+    "                  --quick: 1408)\n"
     "  --no-convergence\n"
     "                  leave the convergence section out\n"
     "  --bodies B      also measure the scene in the files B and C (CSV, or binary\n"
@@ -158,6 +158,8 @@ int run_report(int argc, char** argv) {
   config.convergence = opt.count("no-convergence") == 0;
   if (const auto it = opt.find("convergence-n"); it != opt.end()) {
     config.convergence_n = parse_integer("convergence-n", it->second, 1, 100000000);
+  } else if (config.quick) {
+    config.convergence_n = kQuickConvergenceN;
   }
   if (opt.count("bodies") != opt.count("contacts")) throw UsageError("--bodies and --contacts go together");
   if (opt.count("bodies") != 0) {

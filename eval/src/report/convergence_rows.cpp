@@ -252,8 +252,7 @@ class SceneRows {
 }  // namespace
 
 std::size_t convergence_pile_side(const ReportOptions& options) {
-  const std::size_t n = options.quick ? std::min(options.convergence_n, kQuickConvergenceN) : options.convergence_n;
-  return std::max<std::size_t>(pile_side_for_contacts(n), 2);
+  return std::max<std::size_t>(pile_side_for_contacts(options.convergence_n), 2);
 }
 
 std::vector<ConvergenceRow> measure_convergence_rows(const ReportOptions& options,

@@ -55,8 +55,7 @@ std::vector<HardRow> measure_hard_rows(const ReportOptions& options,
 // ---------------------------------------------------------------------------
 
 /// Boxes per side of the convergence section's pile: the largest pile of
-/// at most options.convergence_n contacts (kQuickConvergenceN with quick),
-/// at least 2.
+/// at most options.convergence_n contacts, at least 2.
 std::size_t convergence_pile_side(const ReportOptions& options);
 /// The pile, the stack and the debris, each in the input then the colour
 /// order: repeat then accumulate at every pass count, then the warm rows;

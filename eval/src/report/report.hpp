@@ -215,7 +215,8 @@ struct ReportOptions {
   bool convergence = true;
   /// Contacts of each scene of the convergence section: the pile is the
   /// largest with at most this many (188800: 40^3 boxes), the stack and the
-  /// debris have the pile's count. With `quick`, at most kQuickConvergenceN.
+  /// debris have the pile's count (`collide report --quick` asks for
+  /// kQuickConvergenceN unless told otherwise).
   std::size_t convergence_n = 188800;
   /// A scene of the caller's, measured beside the generated scenes as the rows of
   /// scene "file" (both empty: none): its bodies and contacts files, CSV or
@@ -225,8 +226,8 @@ struct ReportOptions {
   std::string scene_bodies, scene_contacts;
 };
 
-/// The convergence section's size in a quick run: a pile of 8^3 boxes,
-/// small enough to add well under a second.
+/// The convergence section's size in `collide report --quick`: a pile of
+/// 8^3 boxes, small enough to add well under a second.
 inline constexpr std::size_t kQuickConvergenceN = 1408;
 
 /// Measures every row (and the sweep) and returns them in canonical order
@@ -257,7 +258,7 @@ std::vector<SweepPoint> measure_sweep_report(const ReportOptions& options, const
 std::vector<HardRow> measure_hard_report(const ReportOptions& options);
 
 /// Only the convergence section, for callers that want it alone (the
-/// Python module's report_convergence()). Reads convergence_n, quick, runs
+/// Python module's report_convergence()). Reads convergence_n, seed, runs
 /// and threads (the largest count), checked as measure_report checks them.
 std::vector<ConvergenceRow> measure_convergence_report(const ReportOptions& options);
 
