@@ -34,6 +34,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <optional>
@@ -406,6 +407,16 @@ TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
   EXPECT_EQ(checked, 2U * 3U * 2U);  // friction x models x threads
 }
 
+/// The words joined by spaces: a key of the convergence rows.
+std::string words(std::initializer_list<std::string> parts) {
+  std::string out;
+  for (const std::string& p : parts) {
+    if (!out.empty()) out += ' ';
+    out += p;
+  }
+  return out;
+}
+
 /// The key of a convergence row without its passes.
 std::string convergence_line(const Json& c) {
   return c.at("scene").str + " " + c.at("order").str + " " + c.at("iteration").str + (c.at("warm").b ? " warm" : "");
@@ -438,12 +449,12 @@ TEST_F(ReportRun, TheConvergenceSectionHasEveryRow) {
     for (const std::string order : {"input", "colour"}) {
       for (const std::string mode : {"repeat", "accumulate"}) {
         for (const int passes : {1, 2, 4, 8, 16, 32}) {
-          EXPECT_EQ(seen.count(scene + " " + order + " " + mode + " " + std::to_string(passes)), 1U)
+          EXPECT_EQ(seen.count(words({scene, order, mode, std::to_string(passes)})), 1U)
               << scene << " " << order << " " << mode << " " << passes;
         }
       }
       for (const int passes : {1, 2}) {
-        EXPECT_EQ(seen.count(scene + " " + order + " accumulate warm " + std::to_string(passes)), 1U)
+        EXPECT_EQ(seen.count(words({scene, order, "accumulate warm", std::to_string(passes)})), 1U)
             << scene << " " << order << " warm " << passes;
       }
     }
@@ -483,15 +494,15 @@ TEST_F(ReportRun, ConvergenceResidualsAreWhatTheIterationPromises) {
   }
   for (const std::string scene : {"pile", "stack", "debris"}) {
     for (const std::string order : {"input", "colour"}) {
-      SCOPED_TRACE(scene + " " + order);
+      SCOPED_TRACE(words({scene, order}));
       // One pass from zero is the same solve in both modes, bit for bit.
-      const Json& repeat = *lines.at(scene + " " + order + " repeat").at(1);
-      const Json& accumulate = *lines.at(scene + " " + order + " accumulate").at(1);
+      const Json& repeat = *lines.at(words({scene, order, "repeat"})).at(1);
+      const Json& accumulate = *lines.at(words({scene, order, "accumulate"})).at(1);
       EXPECT_EQ(repeat.at("next_pass").num, accumulate.at("next_pass").num);
       // The support of a resting stack is what a warm start has and a cold
       // pass lacks.
       if (scene == "stack") {
-        EXPECT_LT(lines.at(scene + " " + order + " accumulate warm").at(1)->at("residual").num,
+        EXPECT_LT(lines.at(words({scene, order, "accumulate warm"})).at(1)->at("residual").num,
                   accumulate.at("residual").num);
       }
     }

@@ -107,8 +107,9 @@ Scene<float> make_stack(std::size_t columns) {
       BodyRecord<float> b;
       b.m = 1;
       b.I[0] = b.I[1] = b.I[2] = 1.0F / 6;
+      const std::size_t grid_row = c / side;
       b.p[0] = 2.0F * static_cast<float>(c % side);
-      b.p[1] = 2.0F * static_cast<float>(c / side);
+      b.p[1] = 2.0F * static_cast<float>(grid_row);
       b.p[2] = 0.5F + static_cast<float>(level);
       b.v[2] = -kFall;
       s.bodies.push_back(b);
@@ -124,8 +125,9 @@ Scene<float> make_stack(std::size_t columns) {
       ContactRecord<float> k;
       k.a = box(c, level);
       k.b = level > 0 ? box(c, level - 1) : ground;
+      const std::size_t grid_row = c / side;
       k.c[0] = 2.0F * static_cast<float>(c % side);
-      k.c[1] = 2.0F * static_cast<float>(c / side);
+      k.c[1] = 2.0F * static_cast<float>(grid_row);
       k.c[2] = static_cast<float>(level);
       k.e = 0;
       s.contacts.push_back(k);
