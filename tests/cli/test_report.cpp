@@ -528,6 +528,11 @@ TEST_F(ReportRun, WritesThePng) {
   ASSERT_GE(png.size(), 8U);
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_GT(png.size(), 10000U) << "suspiciously small plot";
+  // Three panels, the convergence section's the third: 800 px each, read
+  // from the PNG's IHDR chunk.
+  ASSERT_GE(png.size(), 24U);
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned>(static_cast<unsigned char>(png[i])); };
+  EXPECT_EQ((byte(16) << 24) | (byte(17) << 16) | (byte(18) << 8) | byte(19), 2400U);
 }
 
 TEST_F(ReportRun, SweepCoversTheRequestedSizes) {
