@@ -94,6 +94,7 @@ __all__ = [
     "save",
     "report",
     "report_hard",
+    "report_convergence",
     "best_isa",
     "isa_supported",
     "simd_width",
@@ -356,6 +357,17 @@ def report_hard(*, n=1000, runs=5):
     ``accurate_error_ulps``; None where this build has no reference precise
     enough to judge it) and judge (that reference's precision)."""
     return _collide.report_hard(n=n, runs=runs)
+
+
+def report_convergence(*, n=188_800, threads=(1, 2), runs=3, seed=1):
+    """The convergence section of ``collide report`` as a list of dicts: a
+    resting pile, a stack of columns and debris of about ``n`` contacts each,
+    solved with 1 to 32 passes in both orders and both iteration modes, and
+    warm-started from the converged J, at the largest of ``threads``. Keys:
+    scene, order, iteration, passes, warm, n, threads, isa, runs, seconds,
+    collisions_per_second (n x passes / seconds), residual, start_residual
+    and next_pass (docs/report.md, "The convergence section")."""
+    return _collide.report_convergence(n=n, threads=list(threads), runs=runs, seed=seed)
 
 
 def isa_supported(isa):

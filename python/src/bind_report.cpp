@@ -42,6 +42,8 @@ py::list report_py(std::size_t n, std::optional<std::size_t> debris_n, std::opti
   o.runs = runs;
   o.seed = seed;
   o.quick = quick;
+  // The rows are all it returns; report_convergence() measures that section.
+  o.convergence = false;
   const Report r = measure_without_gil([&] { return measure_report(o); });
   py::list rows;
   for (const ReportRow& x : r.rows) {
@@ -108,6 +110,37 @@ py::list report_hard_py(std::size_t n, int runs) {
   return rows;
 }
 
+/// The convergence section alone (measure_convergence_report), one dict
+/// per ConvergenceRow.
+py::list report_convergence_py(std::size_t n, std::vector<int> threads, int runs, std::uint64_t seed) {
+  ReportOptions o;
+  o.convergence_n = n;
+  o.threads = std::move(threads);
+  o.runs = runs;
+  o.seed = seed;
+  const std::vector<ConvergenceRow> rows = measure_without_gil([&] { return measure_convergence_report(o); });
+  py::list out;
+  for (const ConvergenceRow& x : rows) {
+    py::dict d;
+    d["scene"] = x.scene;
+    d["order"] = x.order;
+    d["iteration"] = x.iteration;
+    d["passes"] = x.passes;
+    d["warm"] = x.warm;
+    d["n"] = x.n;
+    d["threads"] = x.threads;
+    d["isa"] = x.isa;
+    d["runs"] = x.runs;
+    d["seconds"] = x.seconds;
+    d["collisions_per_second"] = x.collisions_per_second;
+    d["residual"] = x.residual;
+    d["start_residual"] = x.start_residual;
+    d["next_pass"] = x.next_pass;
+    out.append(d);
+  }
+  return out;
+}
+
 }  // namespace
 
 void register_report(py::module_& m) {
@@ -115,6 +148,8 @@ void register_report(py::module_& m) {
         py::arg("pile_n") = py::none(), py::arg("threads") = std::vector<int>{1, 2}, py::arg("sample") = 100000,
         py::arg("runs") = 3, py::arg("seed") = 1, py::arg("quick") = false);
   m.def("report_hard", &report_hard_py, py::kw_only(), py::arg("n") = 1000, py::arg("runs") = 5);
+  m.def("report_convergence", &report_convergence_py, py::kw_only(), py::arg("n") = 188800,
+        py::arg("threads") = std::vector<int>{1, 2}, py::arg("runs") = 3, py::arg("seed") = 1);
 }
 
 }  // namespace collide::python

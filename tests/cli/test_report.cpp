@@ -15,6 +15,12 @@
 //     identical (the paths agree bit for bit), small drifts;
 //   * the PNG exists and starts with the PNG signature. gnuplot is a declared
 //     dependency, so without it this test fails rather than skips;
+//   * the convergence section: every scene, order, mode and pass count,
+//     cold and warm, with residuals that must hold whatever the machine
+//     (the solves give the same bits everywhere): 1 for one cold pass, the
+//     same figures for one pass in both modes, fewer left after 32 passes
+//     than after 1, a warm start below a cold one; --no-convergence leaves
+//     it out;
 //   * stdout is the summary: the speed-against-error frontier of each scene
 //     (the rows no other row of the scene beats on both), computed here again
 //     from the JSON, and where the JSON and the plot are; with --all (a
@@ -28,6 +34,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <optional>
@@ -191,10 +198,15 @@ TEST(ReportAll, PrintsEveryRow) {
   const fs::path dir = fs::path(COLLIDE_TEST_TMP) / "report-all";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const RunResult r = run(dir, {"report", "--quick", "--n", "2000", "--threads", "1", "--runs", "1", "--all", "--json",
-                                (dir / "r.json").string()});
+  const RunResult r = run(dir, {"report", "--quick", "--n", "2000", "--threads", "1", "--runs", "1", "--all",
+                                "--no-convergence", "--json", (dir / "r.json").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Json json = collide::test::JsonParser(slurp(dir / "r.json")).parse();
+  // --no-convergence: no section, in the JSON or the text.
+  EXPECT_TRUE(json.at("convergence").items.empty());
+  EXPECT_EQ(json.at("convergence_pile_side").num, 0);
+  EXPECT_EQ(json.at("phase_seconds").fields.count("convergence"), 0U);
+  EXPECT_EQ(r.out.find("convergence ("), std::string::npos) << r.out;
   std::vector<std::string> expected;
   for (const Json& row : json.at("rows").items) expected.push_back(row_key_text(row));
   EXPECT_EQ(table_rows(r.out), expected) << r.out;
@@ -395,6 +407,112 @@ TEST_F(ReportRun, AccurateRowsAreWithinAFewUlps) {
   EXPECT_EQ(checked, 2U * 3U * 2U);  // friction x models x threads
 }
 
+/// The words joined by spaces: a key of the convergence rows.
+std::string words(std::initializer_list<std::string> parts) {
+  std::string out;
+  for (const std::string& p : parts) {
+    if (!out.empty()) out += ' ';
+    out += p;
+  }
+  return out;
+}
+
+/// The key of a convergence row without its passes.
+std::string convergence_line(const Json& c) {
+  return c.at("scene").str + " " + c.at("order").str + " " + c.at("iteration").str + (c.at("warm").b ? " warm" : "");
+}
+
+TEST_F(ReportRun, TheConvergenceSectionHasEveryRow) {
+  ASSERT_TRUE(report_->json.has("convergence")) << report_->result.err;
+  // --quick: a pile of 8^3 boxes, its contact count for each scene.
+  EXPECT_EQ(report_->json.at("convergence_pile_side").num, 8);
+  EXPECT_EQ(report_->json.at("phase_seconds").fields.count("convergence"), 1U);
+  std::set<std::string> seen;
+  for (const Json& c : report_->json.at("convergence").items) {
+    for (const char* key : {"scene", "order", "iteration", "passes", "warm", "n", "threads", "isa", "runs", "seconds",
+                            "collisions_per_second", "residual", "start_residual", "next_pass"}) {
+      ASSERT_TRUE(c.has(key)) << key;
+    }
+    SCOPED_TRACE(convergence_line(c) + " " + std::to_string(static_cast<int>(c.at("passes").num)));
+    EXPECT_EQ(c.at("n").num, static_cast<double>(collide::pile_contact_count(8)));
+    EXPECT_EQ(c.at("threads").num, 2);  // the largest of the default 1,2
+    EXPECT_EQ(c.at("runs").num, 3);
+    EXPECT_GT(c.at("seconds").num, 0);
+    EXPECT_NEAR(c.at("collisions_per_second").num, c.at("n").num * c.at("passes").num / c.at("seconds").num,
+                1e-5 * c.at("collisions_per_second").num);
+    ASSERT_EQ(c.at("next_pass").kind, Json::number);
+    EXPECT_GE(c.at("next_pass").num, 0);
+    EXPECT_TRUE(!c.at("warm").b || c.at("iteration").str == "accumulate") << "a warm start is accumulate only";
+    seen.insert(convergence_line(c) + " " + std::to_string(static_cast<int>(c.at("passes").num)));
+  }
+  for (const std::string scene : {"pile", "stack", "debris"}) {
+    for (const std::string order : {"input", "colour"}) {
+      for (const std::string mode : {"repeat", "accumulate"}) {
+        for (const int passes : {1, 2, 4, 8, 16, 32}) {
+          EXPECT_EQ(seen.count(words({scene, order, mode, std::to_string(passes)})), 1U)
+              << scene << " " << order << " " << mode << " " << passes;
+        }
+      }
+      for (const int passes : {1, 2}) {
+        EXPECT_EQ(seen.count(words({scene, order, "accumulate warm", std::to_string(passes)})), 1U)
+            << scene << " " << order << " warm " << passes;
+      }
+    }
+  }
+  EXPECT_EQ(seen.size(), 3U * 2U * (2U * 6U + 2U));
+}
+
+TEST_F(ReportRun, ConvergenceResidualsAreWhatTheIterationPromises) {
+  ASSERT_TRUE(report_->json.has("convergence")) << report_->result.err;
+  // Residual by line (scene, order, mode, warm) and passes.
+  std::map<std::string, std::map<int, const Json*>> lines;
+  for (const Json& c : report_->json.at("convergence").items) {
+    lines[convergence_line(c)][static_cast<int>(c.at("passes").num)] = &c;
+  }
+  for (const auto& [key, by_passes] : lines) {
+    SCOPED_TRACE(key);
+    const bool warm = key.find(" warm") != std::string::npos;
+    for (const auto& [passes, c] : by_passes) {
+      // Frictionless: every pass's impulse lies along the contact's normal
+      // total, so no change exceeds the largest J.
+      ASSERT_EQ(c->at("residual").kind, Json::number);
+      EXPECT_GT(c->at("residual").num, 0) << passes;
+      EXPECT_LE(c->at("residual").num, 1) << passes;
+    }
+    if (warm) {
+      // The warm start is the converged J: its own residual is small, and
+      // a warm pass's change is below a cold one's (1).
+      EXPECT_LT(by_passes.at(1)->at("start_residual").num, 0.01);
+      EXPECT_LT(by_passes.at(1)->at("residual").num, 1);
+      continue;
+    }
+    EXPECT_EQ(by_passes.at(1)->at("start_residual").num, 1);
+    // One cold pass: all of J is its change.
+    EXPECT_EQ(by_passes.at(1)->at("residual").num, 1);
+    // Passes converge: 32 leave less than 1.
+    EXPECT_LT(by_passes.at(32)->at("residual").num, by_passes.at(1)->at("residual").num);
+  }
+  for (const std::string scene : {"pile", "stack", "debris"}) {
+    for (const std::string order : {"input", "colour"}) {
+      SCOPED_TRACE(words({scene, order}));
+      // One pass from zero is the same solve in both modes, bit for bit.
+      const Json& repeat = *lines.at(words({scene, order, "repeat"})).at(1);
+      const Json& accumulate = *lines.at(words({scene, order, "accumulate"})).at(1);
+      EXPECT_EQ(repeat.at("next_pass").num, accumulate.at("next_pass").num);
+      // The support of a resting stack is what a warm start has and a cold
+      // pass lacks.
+      if (scene == "stack") {
+        EXPECT_LT(lines.at(words({scene, order, "accumulate warm"})).at(1)->at("residual").num,
+                  accumulate.at("residual").num);
+      }
+    }
+  }
+  // The summary's line.
+  EXPECT_NE(report_->result.out.find(" passes (accumulate, colour) reach residual <= 0.01; warm-started: "),
+            std::string::npos)
+      << report_->result.out;
+}
+
 TEST_F(ReportRun, NoHardRowsWithoutTheFlag) {
   // The hard section is `--hard` only (test_report_hard.cpp runs it).
   ASSERT_TRUE(report_->json.has("hard"));
@@ -410,6 +528,11 @@ TEST_F(ReportRun, WritesThePng) {
   ASSERT_GE(png.size(), 8U);
   EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_GT(png.size(), 10000U) << "suspiciously small plot";
+  // Three panels, the convergence section's the third: 800 px each, read
+  // from the PNG's IHDR chunk.
+  ASSERT_GE(png.size(), 24U);
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned>(static_cast<unsigned char>(png[i])); };
+  EXPECT_EQ((byte(16) << 24) | (byte(17) << 16) | (byte(18) << 8) | byte(19), 2400U);
 }
 
 TEST_F(ReportRun, SweepCoversTheRequestedSizes) {

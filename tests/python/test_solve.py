@@ -280,6 +280,20 @@ def test_report_hard_rows():
         collide.report_hard(runs=0)
 
 
+def test_report_convergence_rows():
+    # The convergence section from Python: every scene, order and mode, one
+    # cold pass leaving all of J to do, a warm start less.
+    rows = collide.report_convergence(n=1408, threads=[1], runs=1)
+    assert len(rows) == 3 * 2 * (2 * 6 + 2)
+    assert {r["scene"] for r in rows} == {"pile", "stack", "debris"}
+    for r in rows:
+        assert 0 < r["residual"] <= 1 and r["seconds"] > 0, r
+        if r["passes"] == 1:
+            assert (r["residual"] < 1) if r["warm"] else (r["residual"] == 1), r
+    with pytest.raises(ValueError, match="convergence_n"):
+        collide.report_convergence(n=0)
+
+
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_generate_chain(dtype):
     bodies, contacts = collide.generate("chain", 500, dtype=dtype)

@@ -1,5 +1,6 @@
 // report/measure.hpp - what the rows of the report share (measure.cpp), the
-// hard section (hard_rows.cpp) and the Bullet peer row (bullet_row.cpp);
+// hard section (hard_rows.cpp), the convergence section
+// (convergence_rows.cpp) and the Bullet peer row (bullet_row.cpp);
 // private to the report engine.
 #pragma once
 
@@ -48,6 +49,19 @@ void fill_error(ReportRow& row, const ImpulseView<const T>& impulses, const Body
 /// catalogue order; `progress` is told what runs.
 std::vector<HardRow> measure_hard_rows(const ReportOptions& options,
                                        const std::function<void(const std::string&)>& progress);
+
+// ---------------------------------------------------------------------------
+// The convergence section (convergence_rows.cpp).
+// ---------------------------------------------------------------------------
+
+/// Boxes per side of the convergence section's pile: the largest pile of
+/// at most options.convergence_n contacts, at least 2.
+std::size_t convergence_pile_side(const ReportOptions& options);
+/// The pile, the stack and the debris, each in the input then the colour
+/// order: repeat then accumulate at every pass count, then the warm rows;
+/// `progress` is told what runs.
+std::vector<ConvergenceRow> measure_convergence_rows(const ReportOptions& options,
+                                                     const std::function<void(const std::string&)>& progress);
 
 // ---------------------------------------------------------------------------
 // The peer (bullet_row.cpp, only with COLLIDE_WITH_BULLET).

@@ -1,8 +1,9 @@
 // report.hpp - the report engine: speed against error of every
 // variant of the solver (and the reference, the textbook loop, the Bullet
-// peer) on the pairs, the debris and the pile scene, as rows, optionally the hard
-// scenes of collide/eval/hard_scenes.hpp in both accuracy modes, and the writers
-// of the table, the JSON and the plot. `collide report` and collide.report() in
+// peer) on the pairs, the debris and the pile scene, as rows, the
+// convergence section (residual against time over passes), optionally the
+// hard scenes of collide/eval/hard_scenes.hpp in both accuracy modes, and
+// the writers of the table, the JSON and the plot. `collide report` and collide.report() in
 // Python are thin shells over it.
 //
 // Design notes
@@ -97,6 +98,34 @@ struct HardRow {
   std::string judge;
 };
 
+/// One solve of the convergence section (convergence_rows.cpp): a pile, a
+/// stack or debris solved by the SIMD path (float, frictionless, fast mode)
+/// with some passes in one order and one iteration mode, cold or warm-started.
+struct ConvergenceRow {
+  std::string scene;      ///< "pile", "stack" or "debris"
+  std::string order;      ///< "input" or "colour" (SolverOptions::order)
+  std::string iteration;  ///< "repeat" or "accumulate" (SolverOptions::iteration)
+  int passes = 1;         ///< SolverOptions::passes
+  /// Started from the converged J of the same scene (SolverOptions::warm_start;
+  /// accumulate only), else from zero.
+  bool warm = false;
+  std::size_t n = 0;  ///< contacts of the scene
+  int threads = 1;
+  std::string isa;
+  int runs = 0;        ///< timed runs (after one untimed warm-up); the speed is their median
+  double seconds = 0;  ///< median time of one solve (all its passes)
+  /// Contact visits per second: n x passes / seconds (the warm start's own
+  /// two visits before the first pass are not counted).
+  double collisions_per_second = 0;
+  double residual = 1;  ///< SolveStats::residual of the solve
+  /// Warm rows: the residual of the converged solve whose J they start from
+  /// (how converged that J is); 1 for the cold rows, which start from 0.
+  double start_residual = 1;
+  /// One more pass (repeat, passes 1) on the solved bodies: its largest |J|
+  /// over the solve's largest |J| (0 when the solve's J are all 0).
+  double next_pass = 0;
+};
+
 /// One point of the throughput-against-N sweep (pairs scene, SIMD, float).
 struct SweepPoint {
   std::string model;
@@ -144,13 +173,17 @@ struct Report {
   std::size_t error_sample = 0;
   bool quick = false;
   double wall_seconds = 0;
-  /// Wall time of each phase ("triad", "pairs", "debris", "pile", "hard", "sweep"), for budgeting.
+  /// Wall time of each phase ("triad", "pairs", "debris", "pile", "convergence", "hard", "sweep"), for budgeting.
   std::vector<std::pair<std::string, double>> phase_seconds;
   std::vector<ReportRow> rows;
   std::vector<SweepPoint> sweep;
   std::size_t hard_n = 0;     ///< pairs of each hard pair family (0: no hard section)
   std::vector<HardRow> hard;  ///< the hard section (--hard), in catalogue order
   std::string peer_status;    ///< "bullet 3.24" or why there is no peer row
+  /// Boxes per side of the convergence section's pile (0: no section); its
+  /// stack and debris have about as many contacts.
+  std::size_t convergence_pile_side = 0;
+  std::vector<ConvergenceRow> convergence;  ///< the convergence section, in its order (convergence_rows.cpp)
 };
 
 // ---------------------------------------------------------------------------
@@ -176,6 +209,15 @@ struct ReportOptions {
   /// and double, fast and accurate, SIMD at one thread (`--hard`).
   bool hard = false;
   std::size_t hard_n = 1000;  ///< pairs of each hard pair family (the shared scenes have fixed sizes)
+  /// The convergence section: a pile, a stack and debris solved with 1 to
+  /// 32 passes in both orders and both iteration modes, and warm-started;
+  /// the residual against the kernel time (`--no-convergence` turns it off).
+  bool convergence = true;
+  /// Contacts of each scene of the convergence section: the pile is the
+  /// largest with at most this many (188800: 40^3 boxes), the stack and the
+  /// debris have the pile's count (`collide report --quick` asks for
+  /// kQuickConvergenceN unless told otherwise).
+  std::size_t convergence_n = 188800;
   /// A scene of the caller's, measured beside the generated scenes as the rows of
   /// scene "file" (both empty: none): its bodies and contacts files, CSV or
   /// binary (.npz) by name, in float and double, its own friction, the
@@ -183,6 +225,10 @@ struct ReportOptions {
   /// contacts.
   std::string scene_bodies, scene_contacts;
 };
+
+/// The convergence section's size in `collide report --quick`: a pile of
+/// 8^3 boxes, small enough to add well under a second.
+inline constexpr std::size_t kQuickConvergenceN = 1408;
 
 /// Measures every row (and the sweep) and returns them in canonical order
 /// (sort_report_rows). Progress goes to stderr only when it is a terminal.
@@ -211,6 +257,11 @@ std::vector<SweepPoint> measure_sweep_report(const ReportOptions& options, const
 /// hard_n and runs, checked as measure_report checks them.
 std::vector<HardRow> measure_hard_report(const ReportOptions& options);
 
+/// Only the convergence section, for callers that want it alone (the
+/// Python module's report_convergence()). Reads convergence_n, seed, runs
+/// and threads (the largest count), checked as measure_report checks them.
+std::vector<ConvergenceRow> measure_convergence_report(const ReportOptions& options);
+
 // ---------------------------------------------------------------------------
 // Output: the order (report_order.cpp), the table (report_table.cpp), the
 // JSON (report_json.cpp) and the plot (report_plot.cpp).
@@ -232,7 +283,8 @@ std::string format_report_table(const Report& report);
 /// wall time.
 std::string format_report_summary(const Report& report, const std::string& json_path, const std::string& plot_path);
 /// The JSON document: {"machine": ..., "rows": [one object per row], "hard": [one object per
-/// hard row; empty without --hard], "sweep": [...]}.
+/// hard row; empty without --hard], "convergence": [one object per convergence row; empty
+/// without the section], "sweep": [...]}.
 std::string format_report_json(const Report& report);
 /// Writes the PNG with gnuplot. Returns "" on success, or why it failed.
 std::string write_report_plot(const Report& report, const std::string& png_path);

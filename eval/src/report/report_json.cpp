@@ -1,6 +1,6 @@
 // report/report_json.cpp - the JSON document of `collide report --json`
 // (format_report_json): the run, the machine, then one object per row, per
-// hard row and per sweep point, keys in a fixed order.
+// hard row, per convergence row and per sweep point, keys in a fixed order.
 //
 // Design notes
 // ------------
@@ -134,6 +134,19 @@ std::string format_report_json(const Report& report) {
          ", \"max_err_eps\": " + json_number(h.max_err_eps) + ", \"p99_err_eps\": " + json_number(h.p99_err_eps) +
          ", \"max_err_ulps\": " + json_number(h.max_err_ulps) + ", \"judge\": " + json_string(h.judge) + "}" +
          (i + 1 < report.hard.size() ? ",\n" : "\n");
+  }
+  s += "  ],\n  \"convergence_pile_side\": " + std::to_string(report.convergence_pile_side) + ",\n";
+  s += "  \"convergence\": [\n";
+  for (std::size_t i = 0; i < report.convergence.size(); ++i) {
+    const ConvergenceRow& c = report.convergence[i];
+    s += "    {\"scene\": " + json_string(c.scene) + ", \"order\": " + json_string(c.order) +
+         ", \"iteration\": " + json_string(c.iteration) + ", \"passes\": " + std::to_string(c.passes) +
+         ", \"warm\": " + (c.warm ? "true" : "false") + ", \"n\": " + std::to_string(c.n) +
+         ", \"threads\": " + std::to_string(c.threads) + ", \"isa\": " + json_string(c.isa) +
+         ", \"runs\": " + std::to_string(c.runs) + ", \"seconds\": " + json_number(c.seconds) +
+         ", \"collisions_per_second\": " + json_number(c.collisions_per_second) +
+         ", \"residual\": " + json_number(c.residual) + ", \"start_residual\": " + json_number(c.start_residual) +
+         ", \"next_pass\": " + json_number(c.next_pass) + "}" + (i + 1 < report.convergence.size() ? ",\n" : "\n");
   }
   s += "  ],\n  \"sweep\": [\n";
   for (std::size_t i = 0; i < report.sweep.size(); ++i) {

@@ -1,6 +1,6 @@
 // report/report_plot.cpp - the PNG of `collide report --plot`
-// (write_report_plot): throughput against error, throughput against N and,
-// with --hard, the hard scenes, drawn by gnuplot.
+// (write_report_plot): throughput against error, throughput against N, the
+// convergence section and, with --hard, the hard scenes, drawn by gnuplot.
 //
 // Design notes
 // ------------
@@ -21,7 +21,12 @@
 //   number of pairs, with the bandwidth bound of each model as a horizontal
 //   line and the N at which the model's working set (bytes_per_collision x N)
 //   fills the L2 caches of the threads and the L3 as vertical lines.
-// * Panel 3, only with --hard: every hard row (collide/eval/hard_scenes.hpp) as a
+// * Panel 3, the convergence section (unless --no-convergence): residual
+//   against the kernel time of the solve, log-log, one line per scene,
+//   order and mode over the pass counts, the warm rows a line of their own,
+//   and the residual 0.01 as a dotted line: how much time each way to a
+//   residual costs.
+// * The last panel, only with --hard: every hard row (collide/eval/hard_scenes.hpp) as a
 //   point, throughput against its max plain relative error (max_err_ulps x
 //   eps), one series per mode and precision, so the cost and the gain of the
 //   accurate mode on the hard cases are one picture.
@@ -129,6 +134,49 @@ std::string gp_string(const std::string& s) {
   return out + "'";
 }
 
+/// The convergence panel (residual against kernel time), or "" without
+/// the section: one data file and one line per scene, order and mode (the
+/// warm rows a mode of their own), written into `tmp`. Colour says the
+/// scene, the dash the order, the point the mode.
+std::string convergence_panel(const Report& report, const std::filesystem::path& tmp) {
+  if (report.convergence.empty()) return {};
+  std::map<std::string, std::string> data;  // by "scene order mode"
+  std::vector<std::string> series;          // in the rows' order
+  for (const ConvergenceRow& c : report.convergence) {
+    const std::string key = c.scene + " " + c.order + " " + (c.warm ? "warm" : c.iteration);
+    if (data.count(key) == 0) series.push_back(key);
+    data[key] += format("%.6e", c.seconds) + " " + format("%.6e", c.residual) + "\n";
+  }
+  const std::map<std::string, std::string> scene_colour = {
+      {"pile", "#d62728"}, {"stack", "#1f77b4"}, {"debris", "#2ca02c"}};
+  const std::map<std::string, std::string> mode_point = {{"repeat", "pt 7"}, {"accumulate", "pt 5"}, {"warm", "pt 9"}};
+  std::string plot;
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const std::string& key = series[i];
+    const std::string file = gp_string((tmp / ("convergence-" + std::to_string(i) + ".dat")).string());
+    std::ofstream(tmp / ("convergence-" + std::to_string(i) + ".dat")) << data.at(key);
+    std::istringstream words(key);
+    std::string scene, order, mode;
+    words >> scene >> order >> mode;
+    if (!plot.empty()) plot += ", \\\n  ";
+    plot += file + " using 1:2 with linespoints lw 1.5 " + (order == "colour" ? "dt 2 " : "dt 1 ") +
+            (mode_point.count(mode) ? mode_point.at(mode) : std::string("pt 7")) + " lc rgb '" +
+            (scene_colour.count(scene) ? scene_colour.at(scene) : std::string("#000000")) + "' title " + gp_string(key);
+  }
+  const ConvergenceRow& first = report.convergence.front();
+  std::string gp = "unset arrow\nunset label\nunset ytics\nset ytics\nset autoscale xy\n";
+  gp += "set title " +
+        gp_string("Convergence: residual against kernel time, 1 to 32 passes (" + std::to_string(first.n) +
+                  " contacts, simd float, " + std::to_string(first.threads) + " threads)") +
+        "\n";
+  gp +=
+      "set xlabel 'seconds per solve (median)'\nset ylabel 'residual (largest change of a J in the last pass / "
+      "largest J)'\n";
+  gp += "set format x '%.0e'\nset format y '%.0e'\nset key bottom left box opaque font ',8'\n";
+  gp += "plot " + plot + ", \\\n  0.01 with lines dt 3 lc rgb '#7f7f7f' title 'residual 0.01'\n";
+  return gp;
+}
+
 }  // namespace
 
 std::string write_report_plot(const Report& report, const std::string& png_path) {
@@ -188,13 +236,15 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
     std::ofstream(tmp / ("hard-" + file + ".dat")) << text;
   }
   const bool hard_panel = !hard.empty();
+  const std::string convergence = convergence_panel(report, tmp);
+  const int panels = 2 + (convergence.empty() ? 0 : 1) + (hard_panel ? 1 : 0);
 
   const std::filesystem::path out_png = std::filesystem::absolute(png_path);
   const std::filesystem::path temp_png = out_png.string() + ".tmp-" + std::to_string(::getpid()) + ".png";
   std::ostringstream gp;
-  gp << "set terminal pngcairo size " << (hard_panel ? "2400" : "1600") << ",760 font 'DejaVu Sans,10' noenhanced\n";
+  gp << "set terminal pngcairo size " << 800 * panels << ",760 font 'DejaVu Sans,10' noenhanced\n";
   gp << "set output " << gp_string(temp_png.string()) << "\n";
-  gp << "set multiplot layout 1," << (hard_panel ? 3 : 2) << " title "
+  gp << "set multiplot layout 1," << panels << " title "
      << gp_string("collide report: " + report.machine.cpu + ", " + std::to_string(report.machine.hardware_threads) +
                   " hardware threads, " + std::to_string(report.n) + " pairs per speed run")
      << " font ',12'\n";
@@ -310,8 +360,9 @@ std::string write_report_plot(const Report& report, const std::string& png_path)
   } else {
     gp << "plot " << plot2 << "\n";
   }
+  gp << convergence;  // panel 3, when the section ran
   if (hard_panel) {
-    // Panel 3: the hard scenes.
+    // The last panel: the hard scenes.
     gp << "unset arrow\nunset label\nunset ytics\nset ytics\nset autoscale y\n";
     gp << "set title "
        << gp_string("Hard scenes (--hard): throughput against error, fast and accurate (simd, 1 thread)") << "\n";

@@ -1,8 +1,9 @@
 // report/report_table.cpp - what `collide report` prints on stdout: by
 // default the summary (format_report_summary: the run and the machine, the
-// speed-against-error frontier of each scene, where the rest is), with
-// --all the whole table (format_report_table: one line per row grouped by
-// scene and friction, then the hard section, the sweep and the wall time).
+// speed-against-error frontier of each scene, the convergence section,
+// where the rest is), with --all the whole table (format_report_table: one
+// line per row grouped by scene and friction, then the convergence and the
+// hard section, the sweep and the wall time).
 //
 // Design notes
 // ------------
@@ -10,7 +11,9 @@
 //   the canonical order (report_order.cpp), so the three agree; the summary's
 //   lines are the table's lines of the frontier rows.
 // * A cache size that could not be read prints "unknown", not 0.
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -157,6 +160,78 @@ std::string hard_lines(const Report& report) {
   return out;
 }
 
+/// The residual the convergence section's summary line asks for.
+constexpr double kConvergedResidual = 0.01;
+
+/// The fewest passes of the convergence rows of `scene`, `order`,
+/// `iteration` and `warm` that reach kConvergedResidual: "4", or "more than
+/// 32" when none of them does.
+std::string passes_to_converge(const Report& report, const std::string& scene, const std::string& order,
+                               const std::string& iteration, bool warm) {
+  int most = 0;
+  for (const ConvergenceRow& c : report.convergence) {
+    if (c.scene != scene || c.order != order || c.iteration != iteration || c.warm != warm) continue;
+    if (c.residual <= kConvergedResidual) return std::to_string(c.passes);
+    most = std::max(most, c.passes);
+  }
+  return "more than " + std::to_string(most);
+}
+
+/// The convergence section, or nothing: per scene and order a line of
+/// residuals per mode, over the pass counts of the cold rows.
+std::string convergence_lines(const Report& report) {
+  if (report.convergence.empty()) return {};
+  const ConvergenceRow& first = report.convergence.front();
+  std::vector<int> passes;
+  for (const ConvergenceRow& c : report.convergence) {
+    if (!c.warm && std::find(passes.begin(), passes.end(), c.passes) == passes.end()) passes.push_back(c.passes);
+  }
+  std::sort(passes.begin(), passes.end());
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "\nconvergence (simd %s float, frictionless, %d thread%s; %zu contacts per scene: a pile of %zu^3 "
+                "boxes and a stack\n"
+                "  of 16-box columns, contacts top first, at rest after one step of gravity, and debris as "
+                "generated): the residual,\n"
+                "  the last pass's largest change of a J over the largest J, after each number of passes; warm: "
+                "accumulate from\n"
+                "  the converged J; ms: the median time of the first column's solve.\n",
+                first.isa.c_str(), first.threads, first.threads == 1 ? "" : "s", first.n, report.convergence_pile_side);
+  out += line;
+  // Indented, so that no line starts with a scene's name as the rows' lines do.
+  out += "  scene  order  mode          ms";
+  for (const int p : passes) out += format("%9.0f", p);
+  out += "\n";
+  const std::vector<ConvergenceRow>& rows = report.convergence;
+  const auto same_line = [](const ConvergenceRow& x, const ConvergenceRow& y) {
+    return x.scene == y.scene && x.order == y.order && x.iteration == y.iteration && x.warm == y.warm;
+  };
+  for (std::size_t i = 0; i < rows.size();) {
+    const ConvergenceRow& head = rows[i];
+    if (i > 0 && head.scene != rows[i - 1].scene) out += "\n";
+    std::size_t end = i;
+    while (end < rows.size() && same_line(rows[end], head)) ++end;
+    std::snprintf(line, sizeof line, "  %-6s %-6s %-10s %7.2f", head.scene.c_str(), head.order.c_str(),
+                  head.warm ? "warm" : head.iteration.c_str(), 1e3 * head.seconds);
+    out += line;
+    for (const int p : passes) {
+      const auto it =
+          std::find_if(rows.begin() + static_cast<std::ptrdiff_t>(i), rows.begin() + static_cast<std::ptrdiff_t>(end),
+                       [p](const ConvergenceRow& c) { return c.passes == p; });
+      if (it != rows.begin() + static_cast<std::ptrdiff_t>(end)) out += format("%9.2g", it->residual);
+    }
+    out += "\n";
+    i = end;
+  }
+  out += "pile: " + passes_to_converge(report, "pile", "colour", "accumulate", false) +
+         " passes (accumulate, colour) reach residual <= 0.01; warm-started: " +
+         passes_to_converge(report, "pile", "colour", "accumulate", true) + "\n";
+  out += "pile: " + passes_to_converge(report, "pile", "colour", "repeat", false) +
+         " passes (repeat, colour) reach residual <= 0.01\n";
+  return out;
+}
+
 /// "wall time 12.3 s (triad 1.0 s, ...)".
 std::string wall_line(const Report& report) {
   char line[512];
@@ -177,6 +252,7 @@ std::string format_report_table(const Report& report) {
   std::vector<std::size_t> all(report.rows.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
   out += row_lines(report, all);
+  out += convergence_lines(report);
   out += hard_lines(report);
   if (!report.sweep.empty()) {
     char line[512];
@@ -203,6 +279,7 @@ std::string format_report_summary(const Report& report, const std::string& json_
   out += line;
   out += kRowHeader;
   out += row_lines(report, frontier);
+  out += convergence_lines(report);
   out += hard_lines(report);
   out += "\nevery row: collide report --all";
   out += json_path.empty() ? ", or --json FILE" : "; as JSON: " + json_path;

@@ -51,7 +51,10 @@
 //   keeps each to a second or so; the row's n and note say so.
 // * The N sweep (panel 2 of the plot) runs on prefixes of one pairs scene of
 //   the largest N: the first N pairs of the pairs scene are the N-pair scene.
-// * The hard section (--hard, hard_rows.cpp) runs after the three scenes:
+// * The convergence section (convergence_rows.cpp) runs after the three
+//   scenes: residual against time for 1 to 32 passes on a resting pile, a
+//   stack and debris, in a scene size of its own (--convergence-n).
+// * The hard section (--hard, hard_rows.cpp) runs after the convergence section:
 //   every hard scene of collide/eval/hard_scenes.hpp in both accuracy modes.
 // * A kernel variant whose error exceeds kImpulseErrorBoundEps makes the
 //   command exit 3, like `solve --check` (and a hard row of the accurate
@@ -288,6 +291,10 @@ class Runner {
       run_file_scene<double>();
       run_file_scene<float>();
       end_phase("file");
+    }
+    if (config_.convergence) {
+      report_.convergence = measure_convergence_rows(config_, [&](const std::string& what) { progress_->show(what); });
+      end_phase("convergence");
     }
     if (config_.hard) {
       report_.hard = measure_hard_rows(config_, [&](const std::string& what) { progress_->show(what); });
@@ -640,11 +647,18 @@ void require_valid(const ReportOptions& options) {
     require(n >= 1 && n <= 0x7FFFFFFFULL, "sweep sizes must be from 1 to 2^31 - 1");
   }
   require(options.hard_n >= 1 && options.hard_n <= 0x7FFFFFFFULL, "hard_n must be from 1 to 2^31 - 1");
+  require(options.convergence_n >= 1 && options.convergence_n <= 100000000,
+          "convergence_n must be from 1 to 100000000");
   require(options.scene_bodies.empty() == options.scene_contacts.empty(),
           "a scene of files needs both its bodies and its contacts file");
 }
 
 }  // namespace
+
+std::vector<ConvergenceRow> measure_convergence_report(const ReportOptions& options) {
+  require_valid(options);
+  return measure_convergence_rows(options, [](const std::string&) {});
+}
 
 ReportRow measure_kernel_speed(const ReportOptions& options, const std::string& scene) {
   require_valid(options);
@@ -707,6 +721,7 @@ Report measure_report(const ReportOptions& options) {
   report.error_sample = report_sample_size(options);
   report.quick = options.quick;
   report.hard_n = options.hard ? options.hard_n : 0;
+  report.convergence_pile_side = options.convergence ? convergence_pile_side(options) : 0;
   const std::string bullet = bullet_version();
   report.peer_status = bullet.empty() ? "not built (libbullet-dev was not found by pkg-config at configure time)"
                                       : bullet + ", btSequentialImpulseConstraintSolver";
