@@ -904,7 +904,7 @@ def test_the_command_takes_a_warm_start(client, tmp_path):
                 "--warm-start", str(tmp_path / "short.npz"))
     assert r.returncode == 1 and r.stderr.startswith(f"collide-dask: error: {tmp_path / 'short.npz'}: warm holds"), \
         r.stderr
-    # scenes: a spec entry's "warm", relative to the spec file.
+    # scenes: an entry's "warm", relative to the JSON file that lists it.
     spec = tmp_path / "spec.json"
     spec.write_text(json.dumps([{"bodies": "b.npz", "contacts": "c.npz", "warm": "j0.npz"},
                                 {"kind": "pairs", "n": 100}]))

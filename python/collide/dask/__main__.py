@@ -78,7 +78,7 @@ def _parser():
 def _scene_entries(inputs):
     """The entries of the scenes subcommand, a spec file's or file pairs,
     and their warm starts (None without any): a spec entry's "warm", a path
-    relative to the spec file, taken out of the entry."""
+    relative to the JSON file that lists it, taken out of the entry."""
     if len(inputs) == 1 and inputs[0].endswith(".json"):
         path = inputs[0]
         with open(path, encoding="utf-8") as f:
