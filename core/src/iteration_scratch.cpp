@@ -86,7 +86,7 @@ void IterationScratch<T>::warm(tbb::task_arena& arena, const ContactView<T>& con
             const T lambda = std::max(along / (nx * nx + ny * ny + nz * nz), T(0));
             const bool kept = friction && contacts.mu[k] > T(0);
             normal_[p] = lambda;
-            target_[p] = T(0);  // measured by the first pass
+            target_[p] = T(0);  // the target visit reads it with the totals, then measures it
             if (friction) {
               friction_[0][p] = kept ? nx * lambda - jx : T(0);
               friction_[1][p] = kept ? ny * lambda - jy : T(0);
