@@ -48,7 +48,7 @@ void packed_twin_pass(oneapi::tbb::task_arena& arena, const collide::PackedView<
   static_assert(sizeof(Record) % sizeof(Row) == 0 && alignof(Record) >= sizeof(Row));
   constexpr std::size_t kWritten = kWrittenValues<Record>;
   const T zero = static_cast<T>(g_packed_zero);
-  const std::uint32_t* order = schedule.order();
+  const std::uint32_t* order = schedule.solve_order();
   const collide::ContactView<T>& c = contacts;
   const collide::ImpulseView<T>& j = impulses;
   Record* bodies = records.bodies;

@@ -294,7 +294,6 @@ void order_row(benchmark::State& state, Kind kind, std::size_t n, collide::Order
   measure_isa_auto<T>(collide::Model::rigid);
   collide::SolverOptions options;
   options.threads = threads;
-  options.order = order;
   options.passes = passes;
   options.iteration = iteration;
   options.warm_start = warm;

@@ -231,7 +231,6 @@ int solve_scene(const SolveRequest& req) {
   options.isa = req.isa;
   options.layout = req.layout;
   options.accuracy = req.accuracy;
-  options.order = req.order;
   options.passes = req.passes;
   options.iteration = req.iteration;
   options.warm_start = !req.warm_start_path.empty();
@@ -249,7 +248,7 @@ int solve_scene(const SolveRequest& req) {
     // from the same warm start.
     reference_solve<long double>(
         ref_bodies.view(), ref_contacts.view(), ref_impulses.view(), diag.data(),
-        SolveSequence{schedule.order(), static_cast<std::size_t>(req.passes), req.iteration, options.warm_start});
+        SolveSequence{schedule.solve_order(), static_cast<std::size_t>(req.passes), req.iteration, options.warm_start});
     check = check_impulses<T>(std::as_const(impulses).view(), std::as_const(ref_impulses).view(), diag);
     check_seconds = seconds_since(t_check);
   }

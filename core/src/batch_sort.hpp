@@ -26,7 +26,7 @@
 
 namespace collide::detail {
 
-/// The batches of a schedule, over its order (Schedule::order()).
+/// The batches of a schedule, over its order (Schedule::solve_order()).
 struct Batches {
   std::vector<std::uint32_t> begin;      ///< batch k is order[begin[k], begin[k + 1])
   std::vector<std::uint8_t> contiguous;  ///< 1 where batch k holds consecutive contacts

@@ -72,7 +72,7 @@ std::size_t Schedule::Impl::level_schedule(const detail::ContactIndices& contact
   return state.conflicts;
 }
 
-Schedule::Schedule(Order order) : impl_(std::make_unique<Impl>()), ordering_(order) {}
+Schedule::Schedule(Order order) : impl_(std::make_unique<Impl>()), order_(order) {}
 Schedule::~Schedule() = default;
 
 Schedule::Schedule(Schedule&& other) noexcept { *this = std::move(other); }
@@ -80,7 +80,7 @@ Schedule::Schedule(Schedule&& other) noexcept { *this = std::move(other); }
 Schedule& Schedule::operator=(Schedule&& other) noexcept {
   if (this == &other) return *this;
   impl_ = std::move(other.impl_);
-  ordering_ = other.ordering_;
+  order_ = other.order_;
   contact_count_ = std::exchange(other.contact_count_, 0);
   body_count_ = std::exchange(other.body_count_, 0);
   batch_count_ = std::exchange(other.batch_count_, 0);
@@ -88,25 +88,25 @@ Schedule& Schedule::operator=(Schedule&& other) noexcept {
   conflicts_ = std::exchange(other.conflicts_, 0);
   colours_ = std::exchange(other.colours_, 0);
   overflow_contacts_ = std::exchange(other.overflow_contacts_, 0);
-  order_ = std::exchange(other.order_, nullptr);
+  solve_order_ = std::exchange(other.solve_order_, nullptr);
   batch_begin_ = std::exchange(other.batch_begin_, nullptr);
   contiguous_ = std::exchange(other.contiguous_, nullptr);
   return *this;
 }
 
-Schedule::Schedule(const Schedule& other) : Schedule(other.ordering_) { *this = other; }
+Schedule::Schedule(const Schedule& other) : Schedule(other.order_) { *this = other; }
 
 Schedule& Schedule::operator=(const Schedule& other) {
   if (this == &other) return *this;
   if (!impl_) impl_ = std::make_unique<Impl>();
   // The result, not the scratch.
-  impl_->order.assign(other.order_, other.order_ + other.contact_count_);
+  impl_->order.assign(other.solve_order_, other.solve_order_ + other.contact_count_);
   if (other.impl_) {
     impl_->batches = other.impl_->batches;
   } else {
     impl_->batches = detail::Batches{};
   }
-  ordering_ = other.ordering_;
+  order_ = other.order_;
   contact_count_ = other.contact_count_;
   body_count_ = other.body_count_;
   conflicts_ = other.conflicts_;
@@ -120,7 +120,7 @@ void Schedule::publish() {
   const detail::Batches& b = impl_->batches;
   batch_count_ = b.count();
   largest_batch_ = b.largest;
-  order_ = impl_->order.data();
+  solve_order_ = impl_->order.data();
   batch_begin_ = b.begin.data();
   contiguous_ = b.contiguous.data();
 }
@@ -175,8 +175,8 @@ void Schedule::build_strided(const ContactView<T>& contacts, std::size_t body_co
       s.batches.begin.assign({std::uint32_t{0}, static_cast<std::uint32_t>(n)});
       s.batches.contiguous.assign(1, 1);
       s.batches.largest = n;
-      colours_ = ordering_ == Order::colour ? 1 : 0;
-    } else if (ordering_ == Order::input) {
+      colours_ = order_ == Order::colour ? 1 : 0;
+    } else if (order_ == Order::input) {
       conflicts = s.level_schedule(indices, masses, workers);
     } else {
       const detail::ColourSummary summary =

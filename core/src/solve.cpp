@@ -219,7 +219,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     // The totals are indexed as the walked J is: by prepared position when
     // the contacts are prepared in the schedule's order.
     if (warm) {
-      iteration<T>().warm(*arena, job.contacts, job.impulses, prepares ? schedule.order() : nullptr, job.friction,
+      iteration<T>().warm(*arena, job.contacts, job.impulses, prepares ? schedule.solve_order() : nullptr, job.friction,
                           measures);
     }
   }
@@ -276,7 +276,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
         *arena, iterated, stepped ? detail::job_kernels(table, job, plan.simd).geometry : nullptr);
     plan.prepared = true;
     passes = walk(on_prepared);
-    prepared_contacts.write_back(*arena, job.impulses, schedule.order());
+    prepared_contacts.write_back(*arena, job.impulses, schedule.solve_order());
   } else {
     passes = walk(iterated);
   }
@@ -298,7 +298,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.allocate_seconds = allocate_seconds;
   stats.layout = job.packed ? BodyLayout::packed : BodyLayout::soa;
   stats.accuracy = options.accuracy;
-  stats.order = schedule.ordering();
+  stats.order = schedule.order();
   stats.colours = schedule.colours();
   stats.overflow_contacts = schedule.overflow_contacts();
   stats.passes = passes;
@@ -320,7 +320,7 @@ KernelJob<T> make_job(Model model, Accuracy accuracy, const ContactView<T>& cont
   job.friction = contacts.mu != nullptr;
   job.contacts = contacts;
   job.impulses = impulses;
-  job.order = schedule.order();
+  job.order = schedule.solve_order();
   return job;
 }
 
@@ -383,25 +383,19 @@ const char* first_null(std::initializer_list<std::pair<const char*, const T*>> a
 /// What keeps a solve inside the caller's arrays, checked in O(1) before
 /// anything is read or written: the schedule was built for as many contacts
 /// and bodies as the views hold (its build checked every index against that
-/// body count) and in the solver's order, J has a slot per contact, and no
-/// array the kernels of `model` read is null. Throws std::invalid_argument
-/// naming the counts, the order or the array. The values are the caller's to
+/// body count), J has a slot per contact, and no array the kernels of
+/// `model` read is null. Throws std::invalid_argument naming the counts or
+/// the array. The values are the caller's to
 /// vouch for (validate()).
 template <class T, class View>
-void check_solve_input(const SolverOptions& options, Model model, const View& bodies, const ContactView<T>& contacts,
-                       const ImpulseView<T>& impulses, const Schedule& schedule) {
+void check_solve_input(Model model, const View& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
+                       const Schedule& schedule) {
   const char* const where = "collide::Solver::solve: ";  // a string only when it throws: a solve allocates nothing
   if (schedule.contact_count() != contacts.count || schedule.body_count() != bodies.count) {
     throw std::invalid_argument(
         std::string(where) + "the schedule was built for " + std::to_string(schedule.contact_count()) +
         " contacts and " + std::to_string(schedule.body_count()) + " bodies, not " + std::to_string(contacts.count) +
         " contacts and " + std::to_string(bodies.count) + " bodies");
-  }
-  if (schedule.ordering() != options.order) {
-    throw std::invalid_argument(
-        std::string(where) + "the schedule is in " + to_string(schedule.ordering()) +
-        " order but the solver's options.order is " + to_string(options.order) +
-        "; build the schedule as collide::Schedule(collide::Order::" + to_string(options.order) + ")");
   }
   if (impulses.count != contacts.count) {
     throw std::invalid_argument(std::string(where) + "impulses.count = " + std::to_string(impulses.count) +
@@ -437,7 +431,7 @@ void check_solve_input(const SolverOptions& options, Model model, const View& bo
 template <class Record, class View, class T>
 SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<T>& contacts,
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
-  detail::check_solve_input(impl_->options, model, bodies, contacts, impulses, schedule);
+  detail::check_solve_input(model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   const std::size_t scattered = detail::scattered_contacts(schedule, contacts.a, contacts.b);
   const detail::IsaPick pick = detail::pick_isa<T>(impl_->options.path, impl_->options.accuracy, impl_->isa_choice,
@@ -472,7 +466,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
 template <class Record, class T>
 SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                                 const ImpulseView<T>& impulses, const Schedule& schedule) const {
-  detail::check_solve_input(impl_->options, model, bodies, contacts, impulses, schedule);
+  detail::check_solve_input(model, bodies, contacts, impulses, schedule);
   detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
   detail::set_view(job, bodies);
   const detail::IsaPick pick =
@@ -526,7 +520,7 @@ SolveStats Solver::solve(Model model, const BodyView<T>& bodies, const ContactVi
   const auto run = [&](const auto& view) {
     // The counts and arrays first: a call they refuse never reaches the
     // debug builds' fit assertion, which reads the bodies of every contact.
-    detail::check_solve_input(impl_->options, model, view, contacts, impulses, schedule);
+    detail::check_solve_input(model, view, contacts, impulses, schedule);
     assert(model_misfit(model, bodies, contacts).empty());
     return solve(view, contacts, impulses, schedule);
   };
@@ -547,12 +541,12 @@ IsaChoice Solver::isa_choice() const { return impl_->isa_choice; }
 
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                 const SolverOptions& options) {
+                 const SolverOptions& options, Order order) {
   if (const Validation v = validate(bodies, contacts, impulses); !v) {
     throw std::invalid_argument("collide::solve: " + v.message);
   }
   const Solver solver(options);  // validates the options before any work
-  Schedule schedule(options.order);
+  Schedule schedule(order);
   schedule.build(contacts, bodies, options.threads);  // on no more threads than the solve may use
   return solver.solve(choose_model(bodies, contacts), bodies, contacts, impulses, schedule);
 }
@@ -576,24 +570,24 @@ using SphereRecords = PackedView<PackedSphere<T>>;
 template <class T>
 using ParticleRecords = PackedView<PackedParticle<T>>;
 
-#define COLLIDE_INSTANTIATE(T)                                                                                  \
-  template SolveStats Solver::solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const SphereView<T>&, const ContactView<T>&, const ImpulseView<T>&,      \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const ParticleView<T>&, const ContactView<T>&, const ImpulseView<T>&,    \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const RigidRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,    \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const SphereRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,   \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(const ParticleRecords<T>&, const ContactView<T>&, const ImpulseView<T>&, \
-                                       const Schedule&) const;                                                  \
-  template SolveStats Solver::solve<T>(Model, const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&, \
-                                       const Schedule&) const;                                                  \
-  template SolveStats solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,                \
-                               const SolverOptions&);                                                           \
-  template std::size_t simd_width<T>();                                                                         \
+#define COLLIDE_INSTANTIATE(T)                                                                                         \
+  template SolveStats Solver::solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,               \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(const SphereView<T>&, const ContactView<T>&, const ImpulseView<T>&,             \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(const ParticleView<T>&, const ContactView<T>&, const ImpulseView<T>&,           \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(const RigidRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,           \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(const SphereRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,          \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(const ParticleRecords<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
+                                       const Schedule&) const;                                                         \
+  template SolveStats Solver::solve<T>(Model, const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&,        \
+                                       const Schedule&) const;                                                         \
+  template SolveStats solve<T>(const BodyView<T>&, const ContactView<T>&, const ImpulseView<T>&, const SolverOptions&, \
+                               Order);                                                                                 \
+  template std::size_t simd_width<T>();                                                                                \
   template std::size_t simd_width<T>(Isa);
 COLLIDE_INSTANTIATE(float)
 COLLIDE_INSTANTIATE(double)

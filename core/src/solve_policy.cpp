@@ -55,7 +55,7 @@ template IsaPick pick_isa<double>(Path, Accuracy, IsaChoice, const KernelTable*,
 /// samples find both bodies far from those of the contact before. The sample reads a few hundred
 /// indices: nothing beside the solve.
 bool prepares_contacts(const Schedule& schedule) {
-  if (schedule.ordering() != Order::colour) return false;
+  if (schedule.order() != Order::colour) return false;
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
     if (!schedule.batch_is_contiguous(k)) return true;
   }
@@ -68,12 +68,12 @@ bool steps_prepared_contacts(std::size_t passes, bool accurate, bool friction) {
 
 std::size_t scattered_contacts(const Schedule& schedule, const BodyIndex* a, const BodyIndex* b) {
   std::size_t n = 0;
-  const std::uint32_t* order = schedule.order();
+  const std::uint32_t* order = schedule.solve_order();
   // A colour of a window holds every few contacts of a stretch of the input:
   // not consecutive, but in a pile or a chain in a broadphase's order their
   // bodies follow one another (the kernel then loads them as vectors,
   // kernel/loops.hpp), so the colour order samples those batches too.
-  const bool sample_gathered = schedule.ordering() == Order::colour;
+  const bool sample_gathered = schedule.order() == Order::colour;
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
     const std::size_t begin = schedule.batch_begin(k);
     const std::size_t size = schedule.batch_begin(k + 1) - begin;

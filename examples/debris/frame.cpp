@@ -43,10 +43,9 @@ double correct_positions(World& w, const Contacts& c) {
   return lifted;
 }
 
-collide::SolverOptions make_solver_options(const Options& o, collide::Order order) {
+collide::SolverOptions make_solver_options(const Options& o) {
   collide::SolverOptions solver_options;
   solver_options.threads = o.threads;
-  solver_options.order = order;
   solver_options.passes = o.passes;  // the passes of a step share its schedule
   solver_options.iteration = o.iteration == "accumulate" ? collide::Iteration::accumulate : collide::Iteration::repeat;
   solver_options.warm_start = o.warm_start;
@@ -59,8 +58,7 @@ std::uint64_t pair_key(collide::BodyIndex a, collide::BodyIndex b) {
 
 }  // namespace
 
-Frame::Frame(const Options& o, collide::Order order)
-    : options_(o), schedule_(order), solver_(make_solver_options(o, order)) {}
+Frame::Frame(const Options& o, collide::Order order) : options_(o), schedule_(order), solver_(make_solver_options(o)) {}
 
 StepFigures Frame::step(World& world) {
   const Options& o = options_;

@@ -128,7 +128,7 @@ class Stats(dict):
         return "Stats({" + ",\n       ".join(f"{k!r}: {v!r}" for k, v in self.items()) + "})"
 
 
-def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", order="input",
+def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, accuracy="fast", order=None,
           passes=1, iteration="repeat", warm=None, schedule=None, out=None, check=True, impacts=True):
     """Resolves every contact in place; returns ``(J, stats)``.
 
@@ -146,10 +146,12 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     "scalar"; ``threads`` 0 for all; ``isa`` None (automatic: COLLIDE_ISA,
     else the fastest on this CPU, measured once per process), "sse2", "avx2"
     or "avx512"; ``accuracy`` "fast" or "accurate". ``order`` is "input"
-    (the law in input order) or "colour" (an order collide chooses: windows
-    of contacts coloured over their bodies, several times faster on piles,
-    stacks and chains; docs/collision-law.md, "The solve order"); a
-    ``schedule`` given must have been built in it. ``passes`` (an integer
+    (the law in input order; the default) or "colour" (an order collide
+    chooses: windows of contacts coloured over their bodies, several times
+    faster on piles, stacks and chains; docs/collision-law.md, "The solve
+    order"): the order of the schedule the call builds. A ``schedule`` given
+    instead runs in the order it was built in (give one or the other, not
+    both). ``passes`` (an integer
     from 1 to 1000000, as ``collide solve --passes``) resolves the contacts
     that many times in that order. ``iteration`` says what the passes after
     the first do: "repeat" (the law again, J summed over the passes) or
@@ -187,22 +189,22 @@ def solve(bodies, contacts, *, model="auto", path="simd", threads=0, isa=None, a
     impulses (``stats["impacts"]`` is then None): at a million contacts that
     pass costs 5 to 10% of a particle solve.
     """
-    solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy, order=order, passes=passes,
-                    iteration=iteration, warm_start=warm is not None)
-    return solver.solve(bodies, contacts, model=model, schedule=schedule, out=out, warm=warm, check=check,
-                        impacts=impacts)
+    solver = Solver(path=path, threads=threads, isa=isa, accuracy=accuracy, passes=passes, iteration=iteration,
+                    warm_start=warm is not None)
+    return solver.solve(bodies, contacts, model=model, order=order, schedule=schedule, out=out, warm=warm,
+                        check=check, impacts=impacts)
 
 
-def reference_solve(bodies, contacts, *, order="input", passes=1, iteration="repeat", warm=None, schedule=None):
+def reference_solve(bodies, contacts, *, order=None, passes=1, iteration="repeat", warm=None, schedule=None):
     """The high-precision reference (long double) on an exact copy of the inputs.
 
     The caller's bodies are not modified. Returns a :class:`Reference` with
     ``J`` (float64 (3, M)), the bodies' ``v`` and ``w`` after it, and
     ``impulse_scale`` per contact. Call it before :func:`solve` (which
     updates the velocities) to compare the two with :func:`impulse_error`,
-    with the solve's ``order``, ``passes``, ``iteration`` and ``warm`` (or its
-    ``schedule``): the reference applies the law in the same sequence, from
-    the same warm start. Packed bodies are
+    with the solve's ``order`` (or its ``schedule``, whose order it is),
+    ``passes``, ``iteration`` and ``warm``: the reference applies the law in
+    the same sequence, from the same warm start. Packed bodies are
     unpacked first (an exact copy).
     """
     if isinstance(bodies, PackedBodies):

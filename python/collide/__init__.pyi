@@ -140,9 +140,9 @@ class Solver:
     threads: int
     isa: IsaName
     accuracy: AccuracyName
-    order: OrderName
     passes: int
     iteration: IterationName
+    warm_start: bool
     def __init__(
         self,
         *,
@@ -150,15 +150,16 @@ class Solver:
         threads: SupportsIndex = 0,
         isa: IsaName | None = None,
         accuracy: AccuracyName = "fast",
-        order: OrderName = "input",
         passes: SupportsIndex = 1,
         iteration: IterationName = "repeat",
+        warm_start: bool = False,
     ) -> None:
         """``threads`` from 0 (all) to 4096 and ``passes`` from 1 to 1000000,
         as the command's options: TypeError for a value that is not an
         integer, ValueError outside the range. Ctrl-C stops a solve of
         several passes on the main thread after the pass in progress
-        (KeyboardInterrupt; the arrays as the passes done left them)."""
+        (KeyboardInterrupt; the arrays as the passes done left them). The
+        order is the schedule's: a Solver runs schedules of either order."""
     def __repr__(self) -> str: ...
     def solve(
         self,
@@ -166,8 +167,10 @@ class Solver:
         contacts: Contacts,
         *,
         model: ModelName = "auto",
+        order: OrderName | None = None,
         schedule: Schedule | None = None,
         out: FloatArray | None = None,
+        warm: FloatArray | None = None,
         check: bool = True,
         impacts: bool = True,
     ) -> tuple[FloatArray, Stats]: ...
@@ -192,9 +195,10 @@ def solve(
     threads: SupportsIndex = 0,
     isa: IsaName | None = None,
     accuracy: AccuracyName = "fast",
-    order: OrderName = "input",
+    order: OrderName | None = None,
     passes: SupportsIndex = 1,
     iteration: IterationName = "repeat",
+    warm: FloatArray | None = None,
     schedule: Schedule | None = None,
     out: FloatArray | None = None,
     check: bool = True,
@@ -218,9 +222,10 @@ def reference_solve(
     bodies: AnyBodies,
     contacts: Contacts,
     *,
-    order: OrderName = "input",
+    order: OrderName | None = None,
     passes: SupportsIndex = 1,
     iteration: IterationName = "repeat",
+    warm: FloatArray | None = None,
     schedule: Schedule | None = None,
 ) -> Reference: ...
 def conservation_drift(bodies: AnyBodies, reference: Reference) -> dict[str, float]: ...

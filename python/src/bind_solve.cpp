@@ -78,10 +78,9 @@ int passes_argument(const py::object& passes) {
 }
 
 SolverOptions solver_options(const std::string& path, const py::object& threads, const py::object& isa,
-                             const std::string& accuracy, const std::string& order, const py::object& passes,
-                             const std::string& iteration, bool warm_start) {
+                             const std::string& accuracy, const py::object& passes, const std::string& iteration,
+                             bool warm_start) {
   SolverOptions o;
-  o.order = parse_order(order);
   o.passes = passes_argument(passes);
   o.iteration = parse_iteration(iteration);
   o.path = parse_path(path);
@@ -152,6 +151,40 @@ struct PySchedule {
   }
 };
 
+/// order= of a solve or a reference solve: None, "input" or "colour".
+std::optional<Order> order_argument(const py::object& order) {
+  if (order.is_none()) return std::nullopt;
+  if (!py::isinstance<py::str>(order)) throw py::type_error("order must be 'input', 'colour' or None");
+  return parse_order(order.cast<std::string>());
+}
+
+/// The schedule owns the order (collide/schedule.hpp): a call takes the
+/// order of a schedule it is given, or order= for the one it builds, not
+/// both. `own` is built (in `order`, else the input order) when no schedule
+/// is given; the schedule to run is returned.
+template <class T, class B>
+PySchedule* schedule_to_run(const char* what, const B& bodies, const Contacts& contacts, const py::object& order,
+                            PySchedule* given, PySchedule& own) {
+  const std::optional<Order> asked = order_argument(order);
+  if (given == nullptr) {
+    own = PySchedule(asked.value_or(Order::input));
+    own.build<T>(bodies, contacts);
+    return &own;
+  }
+  if (asked) {
+    throw py::value_error(std::string(what) +
+                          ": give order= or schedule=, not both: a schedule runs in the order it "
+                          "was built in (this one: '" +
+                          to_string(given->schedule.order()) + "')");
+  }
+  if (given->contacts != contacts.count || given->bodies != bodies.count) {
+    throw py::value_error(std::string(what) + ": schedule was built for " + std::to_string(given->contacts) +
+                          " contacts and " + std::to_string(given->bodies) + " bodies, not " +
+                          std::to_string(contacts.count) + " and " + std::to_string(bodies.count));
+  }
+  return given;
+}
+
 py::dict to_dict(const StatRecord& record) {
   py::dict d;
   for (const auto& entry : record) {
@@ -168,9 +201,9 @@ struct PySolver {
   std::unique_ptr<Solver> solver;
 
   PySolver(const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
-           const std::string& order, const py::object& passes, const std::string& iteration, bool warm_start)
+           const py::object& passes, const std::string& iteration, bool warm_start)
       : solver(std::make_unique<Solver>(
-            stoppable(solver_options(path, threads, isa, accuracy, order, passes, iteration, warm_start)))) {}
+            stoppable(solver_options(path, threads, isa, accuracy, passes, iteration, warm_start)))) {}
 
   SolverOptions stoppable(SolverOptions o) const {
     o.stop = stop.get();
@@ -178,8 +211,8 @@ struct PySolver {
   }
 
   template <class T, class B>
-  py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, PySchedule* schedule,
-                    const py::object& out, const py::object& warm, bool check, bool impacts) {
+  py::tuple solve_t(const B& bodies, const Contacts& contacts, const std::string& model_name, const py::object& order,
+                    PySchedule* schedule, const py::object& out, const py::object& warm, bool check, bool impacts) {
     const std::optional<Model> requested = parse_model(model_name);
     py::array j = impulse_array(out, bodies.dtype, contacts.count);
     const bool warm_start = solver->options().warm_start;
@@ -220,21 +253,9 @@ struct PySolver {
         throw py::value_error(v.message);
       }
     }
-    PySchedule own(solver->options().order);
-    if (schedule == nullptr) {
-      own.build<T>(bodies, contacts);  // before the model choice, which reads the bodies of every contact
-      schedule = &own;
-    } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
-      throw py::value_error("schedule was built for " + std::to_string(schedule->contacts) + " contacts and " +
-                            std::to_string(schedule->bodies) + " bodies, not " + std::to_string(contacts.count) +
-                            " and " + std::to_string(bodies.count));
-    } else if (schedule->schedule.ordering() != solver->options().order) {
-      // The library's message names its C++ call; this one the Python one.
-      const std::string order = to_string(solver->options().order);
-      throw py::value_error(std::string("schedule is in ") + to_string(schedule->schedule.ordering()) +
-                            " order but the solver's order is '" + order +
-                            "': build it as collide.Schedule(bodies, contacts, order=\"" + order + "\")");
-    }
+    // Before the model choice, which reads the bodies of every contact.
+    PySchedule own;
+    schedule = schedule_to_run<T>("solve", bodies, contacts, order, schedule, own);
     const Model model = solve_model<T>(bodies, cv, requested, check);
     if (warm_start) {
       if (!warm_is_out) j[py::ellipsis()] = w;
@@ -275,11 +296,11 @@ struct PySolver {
   }
 
   template <class B>
-  py::tuple solve(const B& bodies, const Contacts& contacts, const std::string& model, PySchedule* schedule,
-                  const py::object& out, const py::object& warm, bool check, bool impacts) {
+  py::tuple solve(const B& bodies, const Contacts& contacts, const std::string& model, const py::object& order,
+                  PySchedule* schedule, const py::object& out, const py::object& warm, bool check, bool impacts) {
     require_same_dtype(bodies, contacts);
     return with_dtype(bodies.dtype, [&](auto tag) {
-      return solve_t<decltype(tag)>(bodies, contacts, model, schedule, out, warm, check, impacts);
+      return solve_t<decltype(tag)>(bodies, contacts, model, order, schedule, out, warm, check, impacts);
     });
   }
 };
@@ -326,9 +347,9 @@ struct Reference {
   }
 };
 
-std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const std::string& order,
+std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contacts& contacts, const py::object& order,
                                               const py::object& passes_in, const std::string& iteration_name,
-                                              const PySchedule* schedule, const py::object& warm) {
+                                              PySchedule* given, const py::object& warm) {
   require_same_dtype(bodies, contacts);
   const int passes = passes_argument(passes_in);
   const Iteration iteration = parse_iteration(iteration_name);
@@ -337,15 +358,8 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
     validate_or_throw<T>(bodies, contacts);
     // The solve's sequence: the given schedule's order, or the one a solve
     // in `order` builds (a schedule depends on the input alone).
-    PySchedule own(parse_order(order));
-    if (schedule == nullptr) {
-      own.build<T>(bodies, contacts);
-      schedule = &own;
-    } else if (schedule->contacts != contacts.count || schedule->bodies != bodies.count) {
-      throw py::value_error("reference_solve: schedule was built for " + std::to_string(schedule->contacts) +
-                            " contacts and " + std::to_string(schedule->bodies) + " bodies, not " +
-                            std::to_string(contacts.count) + " and " + std::to_string(bodies.count));
-    }
+    PySchedule own;
+    const PySchedule* schedule = schedule_to_run<T>("reference_solve", bodies, contacts, order, given, own);
     const bool warm_start = !warm.is_none();
     if (warm_start && iteration != Iteration::accumulate) {
       throw py::value_error(
@@ -358,7 +372,8 @@ std::shared_ptr<Reference> reference_solve_py(const Bodies& bodies, const Contac
       require_length("reference_solve", "warm", w, contacts.count, "contacts.a");
     }
     const Vec3Array<T> wrows = warm_start ? vec3<T>(w) : Vec3Array<T>{};
-    const SolveSequence sequence{schedule->schedule.order(), static_cast<std::size_t>(passes), iteration, warm_start};
+    const SolveSequence sequence{schedule->schedule.solve_order(), static_cast<std::size_t>(passes), iteration,
+                                 warm_start};
     auto r = std::make_shared<Reference>();
     r->dtype = bodies.dtype;
     const BodyView<T> bv = bodies.view<T>();
@@ -447,7 +462,7 @@ void register_solve(py::module_& m) {
            py::arg("order") = "input")
       .def(py::init(&PySchedule::make<PackedBodies>), py::arg("bodies"), py::arg("contacts"), py::kw_only(),
            py::arg("order") = "input")
-      .def_property_readonly("order", [](const PySchedule& s) { return to_string(s.schedule.ordering()); })
+      .def_property_readonly("order", [](const PySchedule& s) { return to_string(s.schedule.order()); })
       .def_property_readonly("batches", [](const PySchedule& s) { return s.schedule.batch_count(); })
       .def_property_readonly("largest_batch", [](const PySchedule& s) { return s.schedule.largest_batch(); })
       .def_property_readonly("colours", [](const PySchedule& s) { return s.schedule.colours(); })
@@ -456,7 +471,8 @@ void register_solve(py::module_& m) {
           "solve_order",
           [](const PySchedule& s) {
             py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(s.schedule.contact_count()));
-            std::copy(s.schedule.order(), s.schedule.order() + s.schedule.contact_count(), out.mutable_data());
+            std::copy(s.schedule.solve_order(), s.schedule.solve_order() + s.schedule.contact_count(),
+                      out.mutable_data());
             return out;
           },
           "The contact indices in the order a solve applies them (uint32, (M,)).")
@@ -464,10 +480,10 @@ void register_solve(py::module_& m) {
       .def("__repr__", [](const PySchedule& s) {
         const Schedule& k = s.schedule;
         std::string text = "collide.Schedule(" + counted(s.contacts, "contact", "contacts") + ", " +
-                           counted(s.bodies, "body", "bodies") + ", order '" + to_string(k.ordering()) +
+                           counted(s.bodies, "body", "bodies") + ", order '" + to_string(k.order()) +
                            "': " + counted(k.batch_count(), "batch", "batches") + ", the largest " +
                            counted(k.largest_batch(), "contact", "contacts");
-        if (k.ordering() == Order::colour) {
+        if (k.order() == Order::colour) {
           text += ", " + counted(k.colours(), "colour", "colours") + ", " +
                   counted(k.overflow_contacts(), "overflow contact", "overflow contacts");
         }
@@ -475,16 +491,15 @@ void register_solve(py::module_& m) {
       });
 
   py::class_<PySolver>(m, "Solver")
-      .def(py::init<const std::string&, const py::object&, const py::object&, const std::string&, const std::string&,
-                    const py::object&, const std::string&, bool>(),
+      .def(py::init<const std::string&, const py::object&, const py::object&, const std::string&, const py::object&,
+                    const std::string&, bool>(),
            py::kw_only(), py::arg("path") = "simd", py::arg("threads") = 0, py::arg("isa") = py::none(),
-           py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1,
-           py::arg("iteration") = "repeat", py::arg("warm_start") = false)
+           py::arg("accuracy") = "fast", py::arg("passes") = 1, py::arg("iteration") = "repeat",
+           py::arg("warm_start") = false)
       .def_property_readonly("path", [](const PySolver& s) { return to_string(s.solver->options().path); })
       .def_property_readonly("threads", [](const PySolver& s) { return s.solver->options().threads; })
       .def_property_readonly("isa", [](const PySolver& s) { return to_string(s.solver->isa()); })
       .def_property_readonly("accuracy", [](const PySolver& s) { return to_string(s.solver->options().accuracy); })
-      .def_property_readonly("order", [](const PySolver& s) { return to_string(s.solver->options().order); })
       .def_property_readonly("passes", [](const PySolver& s) { return s.solver->options().passes; })
       .def_property_readonly("iteration", [](const PySolver& s) { return to_string(s.solver->options().iteration); })
       .def_property_readonly("warm_start", [](const PySolver& s) { return s.solver->options().warm_start; })
@@ -493,16 +508,17 @@ void register_solve(py::module_& m) {
              const SolverOptions& o = s.solver->options();
              return std::string("collide.Solver(path='") + to_string(o.path) +
                     "', threads=" + std::to_string(o.threads) + ", isa='" + to_string(s.solver->isa()) +
-                    "', accuracy='" + to_string(o.accuracy) + "', order='" + to_string(o.order) +
-                    "', passes=" + std::to_string(o.passes) + ", iteration='" + to_string(o.iteration) + "'" +
-                    (o.warm_start ? ", warm_start=True" : "") + ")";
+                    "', accuracy='" + to_string(o.accuracy) + "', passes=" + std::to_string(o.passes) +
+                    ", iteration='" + to_string(o.iteration) + "'" + (o.warm_start ? ", warm_start=True" : "") + ")";
            })
       .def("solve", &PySolver::solve<Bodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
-           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
-           py::arg("warm") = py::none(), py::arg("check") = true, py::arg("impacts") = true)
+           py::arg("model") = "auto", py::arg("order") = py::none(), py::arg("schedule") = nullptr,
+           py::arg("out") = py::none(), py::arg("warm") = py::none(), py::arg("check") = true,
+           py::arg("impacts") = true)
       .def("solve", &PySolver::solve<PackedBodies>, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
-           py::arg("model") = "auto", py::arg("schedule") = nullptr, py::arg("out") = py::none(),
-           py::arg("warm") = py::none(), py::arg("check") = true, py::arg("impacts") = true);
+           py::arg("model") = "auto", py::arg("order") = py::none(), py::arg("schedule") = nullptr,
+           py::arg("out") = py::none(), py::arg("warm") = py::none(), py::arg("check") = true,
+           py::arg("impacts") = true);
 
   py::class_<ThreadLimit>(m, "ThreadLimit")
       .def(py::init<int>(), py::arg("threads"))
@@ -536,13 +552,13 @@ void register_solve(py::module_& m) {
       "solve_options",
       [](const std::string& path, const py::object& threads, const py::object& isa, const std::string& accuracy,
          const std::string& order, const py::object& passes, const std::string& iteration, bool warm_start) {
-        const SolverOptions o = solver_options(path, threads, isa, accuracy, order, passes, iteration, warm_start);
+        const SolverOptions o = solver_options(path, threads, isa, accuracy, passes, iteration, warm_start);
         py::dict d;
         d["path"] = to_string(o.path);
         d["threads"] = o.threads;
         d["isa"] = o.isa == Isa::automatic ? py::object(py::none()) : py::object(py::str(to_string(o.isa)));
         d["accuracy"] = to_string(o.accuracy);
-        d["order"] = to_string(o.order);
+        d["order"] = to_string(parse_order(order));  // the schedule's, which collide.solve builds
         d["passes"] = o.passes;
         d["iteration"] = to_string(o.iteration);
         d["warm_start"] = o.warm_start;
@@ -552,7 +568,7 @@ void register_solve(py::module_& m) {
       py::arg("accuracy") = "fast", py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat",
       py::arg("warm_start") = false);
   m.def("reference_solve", &reference_solve_py, py::arg("bodies"), py::arg("contacts"), py::kw_only(),
-        py::arg("order") = "input", py::arg("passes") = 1, py::arg("iteration") = "repeat",
+        py::arg("order") = py::none(), py::arg("passes") = 1, py::arg("iteration") = "repeat",
         py::arg("schedule") = nullptr, py::arg("warm") = py::none());
   m.def("impulse_error", &impulse_error_py, py::arg("J"), py::arg("reference"));
   m.def("conservation_drift", &conservation_drift_py, py::arg("bodies"), py::arg("reference"));

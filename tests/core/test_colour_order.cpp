@@ -11,7 +11,7 @@
 //   colours and levels, window by window. It is the same for 1, 2 and 3
 //   threads, and no two contacts of a batch share a movable body.
 // * A colour-order solve is the law applied sequentially in
-//   Schedule::order(): bitwise what the one-lane kernel gives on the contacts
+//   Schedule::solve_order(): bitwise what the one-lane kernel gives on the contacts
 //   permuted into that order and solved in input order, on one thread; for
 //   every thread count, path, ISA, body layout, model, precision and
 //   accuracy mode, on pairs, debris, a pile (in cell order and shuffled), a
@@ -156,7 +156,7 @@ template <class T>
 std::vector<std::vector<std::uint32_t>> batches_of(const Schedule& s) {
   std::vector<std::vector<std::uint32_t>> out;
   for (std::size_t k = 0; k < s.batch_count(); ++k) {
-    out.emplace_back(s.order() + s.batch_begin(k), s.order() + s.batch_begin(k + 1));
+    out.emplace_back(s.solve_order() + s.batch_begin(k), s.solve_order() + s.batch_begin(k + 1));
   }
   return out;
 }
@@ -176,7 +176,7 @@ TEST_P(ColourSchedule, IsTheDocumentedRuleOnEveryThreadCount) {
     SCOPED_TRACE(std::string(name(GetParam())) + ", " + std::to_string(threads) + " threads");
     Schedule s(Order::colour);
     s.build(cv, b.count, b.inv_mass, threads);
-    ASSERT_EQ(s.ordering(), Order::colour);
+    ASSERT_EQ(s.order(), Order::colour);
     ASSERT_EQ(s.contact_count(), c.count);
     const auto got = batches_of<double>(s);
     if (GetParam() == Kind::pairs) {
@@ -265,13 +265,14 @@ ContactBuffer<T> permuted(const ContactView<T>& c, const std::uint32_t* order) {
   return out;
 }
 
-/// One solve of `scene` (a copy of its bodies) with `options`, in the schedule's order.
+/// One solve of `scene` (a copy of its bodies) with `options`, on a schedule in `order`.
 template <class T>
-std::pair<BodyBuffer<T>, ImpulseBuffer<T>> solve_copy(const Scene<T>& scene, Model model, SolverOptions options) {
+std::pair<BodyBuffer<T>, ImpulseBuffer<T>> solve_copy(const Scene<T>& scene, Model model, const SolverOptions& options,
+                                                      Order order = Order::input) {
   BodyBuffer<T> bodies = scene.bodies;
   const ContactView<T> c = scene.contacts.view();
   ImpulseBuffer<T> j(c.count);
-  Schedule schedule(options.order);
+  Schedule schedule(order);
   schedule.build(c, bodies.view(), options.threads);
   Solver(options).solve(model, bodies.view(), c, j.view(), schedule);
   return {std::move(bodies), std::move(j)};
@@ -285,7 +286,7 @@ std::pair<BodyBuffer<T>, ImpulseBuffer<T>> sequential_in_colour_order(const Scen
   const ContactView<T> c = scene.contacts.view();
   Schedule colour(Order::colour);
   colour.build(c, scene.bodies.view().count, scene.bodies.view().inv_mass, 1);
-  const ContactBuffer<T> in_order = permuted<T>(c, colour.order());
+  const ContactBuffer<T> in_order = permuted<T>(c, colour.solve_order());
   BodyBuffer<T> bodies = scene.bodies;
   ImpulseBuffer<T> j_sorted(c.count);
   Schedule input;
@@ -301,7 +302,7 @@ std::pair<BodyBuffer<T>, ImpulseBuffer<T>> sequential_in_colour_order(const Scen
   Solver(o).solve(model, bodies.view(), pc, j_sorted.view(), input);
   ImpulseBuffer<T> j(c.count);
   for (std::size_t i = 0; i < c.count; ++i) {
-    const std::size_t k = colour.order()[i];
+    const std::size_t k = colour.solve_order()[i];
     j.view().j.x[k] = j_sorted.view().j.x[i];
     j.view().j.y[k] = j_sorted.view().j.y[i];
     j.view().j.z[k] = j_sorted.view().j.z[i];
@@ -332,11 +333,10 @@ void expect_sequential_law(const SolveCase& p, Model model, Accuracy accuracy) {
           SCOPED_TRACE(std::to_string(passes) + " passes, " + std::to_string(threads) + " threads, " + to_string(path) +
                        ", " + to_string(layout));
           SolverOptions o = options_for(path, threads, 64);
-          o.order = Order::colour;
           o.layout = layout;
           o.accuracy = accuracy;
           o.passes = passes;
-          const auto [bodies, j] = solve_copy(scene, model, o);
+          const auto [bodies, j] = solve_copy(scene, model, o, Order::colour);
           EXPECT_TRUE(same_impulses(j, want_j));
           EXPECT_TRUE(same_bodies(bodies, want_bodies));
         }
@@ -376,14 +376,13 @@ INSTANTIATE_TEST_SUITE_P(Scenes, ColourSolve,
 TEST(ColourSolve, EveryIsaGivesTheSameBytes) {
   const Scene<float> scene = make_scene<float>(Kind::pile, 20000, true);
   SolverOptions o = options_for(Path::simd, 2, 256);
-  o.order = Order::colour;
   o.isa = Isa::sse2;
-  const auto [want_bodies, want_j] = solve_copy(scene, Model::rigid, o);
+  const auto [want_bodies, want_j] = solve_copy(scene, Model::rigid, o, Order::colour);
   for (const Isa isa : {Isa::avx2, Isa::avx512}) {
     if (!isa_supported(isa)) continue;
     SCOPED_TRACE(to_string(isa));
     o.isa = isa;
-    const auto [bodies, j] = solve_copy(scene, Model::rigid, o);
+    const auto [bodies, j] = solve_copy(scene, Model::rigid, o, Order::colour);
     EXPECT_TRUE(same_impulses(j, want_j));
     EXPECT_TRUE(same_bodies(bodies, want_bodies));
   }
@@ -395,7 +394,6 @@ TEST(ColourSolve, TheReferenceReplayingItsOrderIsWithinTheBound) {
       SCOPED_TRACE(std::string(name(kind)) + ", " + std::to_string(passes) + " passes");
       const Scene<float> scene = make_scene<float>(kind, 20000, kind == Kind::debris);
       SolverOptions o = options_for(Path::simd, 2, 256);
-      o.order = Order::colour;
       o.passes = passes;
       BodyBuffer<float> bodies = scene.bodies;
       const ContactView<float> c = scene.contacts.view();
@@ -408,7 +406,7 @@ TEST(ColourSolve, TheReferenceReplayingItsOrderIsWithinTheBound) {
       ImpulseBuffer<long double> ref_j(c.count);
       std::vector<ReferenceContact<long double>> diag(c.count);
       reference_solve<long double>(ref_bodies.view(), ref_contacts.view(), ref_j.view(), diag.data(),
-                                   SolveSequence{schedule.order(), static_cast<std::size_t>(passes)});
+                                   SolveSequence{schedule.solve_order(), static_cast<std::size_t>(passes)});
       const ImpulseCheck check = check_impulses<float>(std::as_const(j).view(), std::as_const(ref_j).view(), diag);
       EXPECT_TRUE(check.passed) << check.max_error_eps << " eps at contact " << check.worst_contact;
       // In input order the reference disagrees: the order is the solve's own.
@@ -427,11 +425,12 @@ TEST(ColourSolve, TheReferenceReplayingItsOrderIsWithinTheBound) {
 
 /// J of `passes` solves added in turn, as a caller would, and the bodies after.
 template <class T>
-std::pair<BodyBuffer<T>, ImpulseBuffer<T>> repeated_solves(const Scene<T>& scene, SolverOptions o, int passes) {
+std::pair<BodyBuffer<T>, ImpulseBuffer<T>> repeated_solves(const Scene<T>& scene, SolverOptions o, int passes,
+                                                           Order order) {
   BodyBuffer<T> bodies = scene.bodies;
   const ContactView<T> c = scene.contacts.view();
   ImpulseBuffer<T> sum(c.count);
-  Schedule schedule(o.order);
+  Schedule schedule(order);
   schedule.build(c, bodies.view());
   o.passes = 1;
   const Solver solver(o);
@@ -459,10 +458,9 @@ TEST(Passes, AreThatManySolvesWithTheirImpulsesAdded) {
         SCOPED_TRACE(std::string(to_string(order)) + " " + name(kind) + (friction ? " friction" : ""));
         const Scene<float> scene = make_scene<float>(kind, 20000, friction);
         SolverOptions o = options_for(Path::simd, 2, 128);
-        o.order = order;
-        const auto [want_bodies, want_j] = repeated_solves(scene, o, 4);
+        const auto [want_bodies, want_j] = repeated_solves(scene, o, 4, order);
         o.passes = 4;
-        const auto [bodies, j] = solve_copy(scene, Model::rigid, o);
+        const auto [bodies, j] = solve_copy(scene, Model::rigid, o, order);
         EXPECT_TRUE(same_impulses(j, want_j));
         EXPECT_TRUE(same_bodies(bodies, want_bodies));
         // The sequential law in the colour order, four passes.
@@ -476,14 +474,15 @@ TEST(Passes, AreThatManySolvesWithTheirImpulsesAdded) {
   }
 }
 
-/// A solve of `scene` with `o` (a copy of its bodies), and its stats.
+/// A solve of `scene` with `o` (a copy of its bodies) on a schedule in `order`, and its stats.
 template <class T>
 std::pair<std::pair<BodyBuffer<T>, ImpulseBuffer<T>>, SolveStats> solve_with_stats(const Scene<T>& scene,
-                                                                                   const SolverOptions& o) {
+                                                                                   const SolverOptions& o,
+                                                                                   Order order) {
   BodyBuffer<T> bodies = scene.bodies;
   const ContactView<T> c = scene.contacts.view();
   ImpulseBuffer<T> j(c.count);
-  Schedule schedule(o.order);
+  Schedule schedule(order);
   schedule.build(c, bodies.view());
   const SolveStats stats = Solver(o).solve(Model::rigid, bodies.view(), c, j.view(), schedule);
   return {{std::move(bodies), std::move(j)}, stats};
@@ -495,11 +494,10 @@ TEST(Passes, AStopSetBeforeTheSolveEndsItAfterThePassInProgress) {
   for (const Order order : {Order::input, Order::colour}) {
     SCOPED_TRACE(to_string(order));
     SolverOptions o = options_for(Path::simd, 2, 128);
-    o.order = order;
-    const auto [want, want_stats] = solve_with_stats(scene, o);  // one pass
+    const auto [want, want_stats] = solve_with_stats(scene, o, order);  // one pass
     o.passes = 1000;
     o.stop = &stop;
-    const auto [got, stats] = solve_with_stats(scene, o);
+    const auto [got, stats] = solve_with_stats(scene, o, order);
     EXPECT_EQ(stats.passes, 1u);
     EXPECT_TRUE(same_impulses(got.second, want.second));
     EXPECT_TRUE(same_bodies(got.first, want.first));
@@ -518,7 +516,6 @@ TEST(Passes, AStopSetDuringTheSolveLeavesTheWholePassesItReports) {
                        " threads, " + to_string(layout));
           std::atomic<bool> stop{false};
           SolverOptions o = options_for(Path::simd, threads, 128);
-          o.order = order;
           o.layout = layout;
           o.passes = kPasses;
           o.stop = &stop;
@@ -527,7 +524,7 @@ TEST(Passes, AStopSetDuringTheSolveLeavesTheWholePassesItReports) {
             stop.store(true);
           });
           const auto t0 = std::chrono::steady_clock::now();
-          const auto [got, stats] = solve_with_stats(scene, o);
+          const auto [got, stats] = solve_with_stats(scene, o, order);
           const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
           stopper.join();
           ASSERT_GE(stats.passes, 1u);
@@ -536,7 +533,7 @@ TEST(Passes, AStopSetDuringTheSolveLeavesTheWholePassesItReports) {
           // The same bits as a solve of that many passes, run to its end.
           o.passes = static_cast<int>(stats.passes);
           o.stop = nullptr;
-          const auto [want, want_stats] = solve_with_stats(scene, o);
+          const auto [want, want_stats] = solve_with_stats(scene, o, order);
           EXPECT_EQ(want_stats.passes, stats.passes);
           EXPECT_TRUE(same_impulses(got.second, want.second));
           EXPECT_TRUE(same_bodies(got.first, want.first));
@@ -550,11 +547,10 @@ TEST(Passes, AClearStopRunsEveryPass) {
   const Scene<float> scene = make_scene<float>(Kind::debris, 20000, true);
   const std::atomic<bool> stop{false};
   SolverOptions o = options_for(Path::simd, 2, 128);
-  o.order = Order::colour;
   o.passes = 3;
-  const auto [want, want_stats] = solve_with_stats(scene, o);
+  const auto [want, want_stats] = solve_with_stats(scene, o, Order::colour);
   o.stop = &stop;
-  const auto [got, stats] = solve_with_stats(scene, o);
+  const auto [got, stats] = solve_with_stats(scene, o, Order::colour);
   EXPECT_EQ(stats.passes, 3u);
   EXPECT_EQ(want_stats.passes, 3u);
   EXPECT_TRUE(same_impulses(got.second, want.second));
@@ -567,20 +563,29 @@ TEST(Passes, ZeroIsRefused) {
   EXPECT_THROW(Solver{o}, std::invalid_argument);
 }
 
-TEST(ColourSolve, ASolverRefusesAScheduleOfTheOtherOrder) {
-  Scene<double> scene = make_scene<double>(Kind::pile, 1000, false);
+TEST(ColourSolve, OneSolverRunsEachScheduleInTheScheduleOrder) {
+  // The schedule owns the order: one Solver, given schedules of both orders
+  // in turn, gives each order's own bits and says which order ran.
+  const Scene<double> scene = make_scene<double>(Kind::pile, 1000, false);
   const ContactView<double> c = scene.contacts.view();
-  ImpulseBuffer<double> j(c.count);
-  Schedule input;
-  input.build(c, scene.bodies.view());
-  SolverOptions o;
-  o.order = Order::colour;
-  try {
-    Solver(o).solve(scene.bodies.view(), c, j.view(), input);
-    ADD_FAILURE() << "no error";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("collide::Schedule(collide::Order::colour)"), std::string::npos) << e.what();
+  const SolverOptions o = options_for(Path::simd, 2, 64);
+  const Solver solver(o);
+  for (const Order order : {Order::colour, Order::input, Order::colour}) {
+    SCOPED_TRACE(to_string(order));
+    const auto [want_bodies, want_j] = solve_copy(scene, Model::rigid, o, order);
+    BodyBuffer<double> bodies = scene.bodies;
+    ImpulseBuffer<double> j(c.count);
+    Schedule schedule(order);
+    schedule.build(c, bodies.view());
+    const SolveStats stats = solver.solve(Model::rigid, bodies.view(), c, j.view(), schedule);
+    EXPECT_EQ(stats.order, order);
+    EXPECT_TRUE(same_impulses(j, want_j));
+    EXPECT_TRUE(same_bodies(bodies, want_bodies));
   }
+  // The two orders give other bits on a pile, so the loop tells them apart.
+  const auto [input_bodies, input_j] = solve_copy(scene, Model::rigid, o, Order::input);
+  const auto [colour_bodies, colour_j] = solve_copy(scene, Model::rigid, o, Order::colour);
+  EXPECT_FALSE(same_impulses(input_j, colour_j));
 }
 
 TEST(ColourSolve, ImmovableBodiesAreNeverChanged) {
@@ -593,10 +598,9 @@ TEST(ColourSolve, ImmovableBodiesAreNeverChanged) {
     const Scene<float> scene = make_scene<float>(kind, 20000, friction);
     for (const BodyLayout layout : {BodyLayout::soa, BodyLayout::packed}) {
       SolverOptions o = options_for(Path::simd, 2, 64);
-      o.order = Order::colour;
       o.layout = layout;
       o.passes = 3;
-      const auto [bodies, j] = solve_copy(scene, Model::rigid, o);
+      const auto [bodies, j] = solve_copy(scene, Model::rigid, o, Order::colour);
       const BodyView<const float> before = std::as_const(scene.bodies).view();
       std::size_t immovable = 0;
       for (std::size_t i = 0; i < before.count; ++i) immovable += before.inv_mass[i] == 0 ? 1 : 0;
@@ -610,21 +614,20 @@ TEST(ColourSolve, ANaNReachesOnlyWhatFollowsItOnItsBodies) {
   Scene<float> scene = make_scene<float>(Kind::pile, 20000, false);
   const ContactView<float> c = scene.contacts.view();
   SolverOptions o = options_for(Path::simd, 2, 64);
-  o.order = Order::colour;
-  const auto [clean_bodies, clean_j] = solve_copy(scene, Model::rigid, o);
+  const auto [clean_bodies, clean_j] = solve_copy(scene, Model::rigid, o, Order::colour);
   Schedule schedule(Order::colour);
   schedule.build(c, scene.bodies.view());
   // Poison a contact in the middle of the order; walk the order from there:
   // a contact is reached when one of its movable bodies is.
   const std::size_t at = c.count / 2;
-  const std::uint32_t victim = schedule.order()[at];
+  const std::uint32_t victim = schedule.solve_order()[at];
   // Past the buffer's checks, on purpose: the buffer owns the array.
   const_cast<float*>(c.n.x)[victim] = std::numeric_limits<float>::quiet_NaN();
   const BodyView<const float> b = std::as_const(scene.bodies).view();
   std::vector<char> body_reached(b.count, 0);
   std::vector<char> contact_reached(c.count, 0);
   for (std::size_t i = at; i < c.count; ++i) {
-    const std::uint32_t k = schedule.order()[i];
+    const std::uint32_t k = schedule.solve_order()[i];
     const bool moves_a = b.inv_mass[c.a[k]] != 0;
     const bool moves_b = b.inv_mass[c.b[k]] != 0;
     if (k == victim || (moves_a && body_reached[c.a[k]]) || (moves_b && body_reached[c.b[k]])) {
@@ -633,7 +636,7 @@ TEST(ColourSolve, ANaNReachesOnlyWhatFollowsItOnItsBodies) {
       if (moves_b) body_reached[c.b[k]] = 1;
     }
   }
-  const auto [bodies, j] = solve_copy(scene, Model::rigid, o);
+  const auto [bodies, j] = solve_copy(scene, Model::rigid, o, Order::colour);
   EXPECT_TRUE(same_impulses(j, clean_j, [&](std::size_t k) { return contact_reached[k] != 0; }));
   EXPECT_TRUE(same_bodies(bodies, clean_bodies, [&](std::size_t i) { return body_reached[i] != 0; }));
   EXPECT_TRUE(std::isnan(j.view().j.x[victim]));

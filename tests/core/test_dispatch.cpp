@@ -302,7 +302,6 @@ void solve_choice(const SceneRecords<T>& records, const Choice& c, Path path, Is
   o.threads = 1;
   o.accuracy = c.accurate ? Accuracy::accurate : Accuracy::fast;
   o.layout = c.packed ? BodyLayout::packed : BodyLayout::soa;
-  o.order = order;
   o.passes = passes;
   o.iteration = c.accumulates ? Iteration::accumulate : Iteration::repeat;
   const ContactView<T> contacts = scene.contacts.view();

@@ -37,14 +37,14 @@
 namespace collide::test {
 namespace {
 
-/// One solve of a copy of `scene`'s bodies with `options`.
+/// One solve of a copy of `scene`'s bodies with `options`, on a schedule in `order`.
 template <class T>
 std::pair<BodyBuffer<T>, ImpulseBuffer<T>> solved(const Scene<T>& scene, Model model, const SolverOptions& options,
-                                                  SolveStats* stats = nullptr) {
+                                                  Order order = Order::input, SolveStats* stats = nullptr) {
   BodyBuffer<T> bodies = scene.bodies;
   const ContactView<T> c = scene.contacts.view();
   ImpulseBuffer<T> j(c.count);
-  Schedule schedule(options.order);
+  Schedule schedule(order);
   schedule.build(c, bodies.view(), options.threads);
   const SolveStats s = Solver(options).solve(model, bodies.view(), c, j.view(), schedule);
   if (stats != nullptr) *stats = s;
@@ -78,12 +78,11 @@ void expect_one_pass_is_the_repeat_pass(Model model) {
           SCOPED_TRACE(std::string(type_name<T>()) + " " + to_string(model) + (friction ? " friction " : " ") +
                        to_string(order) + " " + to_string(path) + " " + to_string(layout));
           SolverOptions o = options_for(path, 2, 256);
-          o.order = order;
           o.layout = layout;
-          const auto [want_bodies, want_j] = solved(scene, model, o);
+          const auto [want_bodies, want_j] = solved(scene, model, o, order);
           o.iteration = Iteration::accumulate;
           SolveStats stats;
-          const auto [bodies, j] = solved(scene, model, o, &stats);
+          const auto [bodies, j] = solved(scene, model, o, order, &stats);
           EXPECT_EQ(stats.iteration, Iteration::accumulate);
           EXPECT_TRUE(same_impulses(j, want_j));
           EXPECT_TRUE(same_bodies(bodies, want_bodies));
@@ -105,11 +104,10 @@ void expect_same_bits_everywhere(const Scene<T>& scene, bool pile_scene) {
   for (const Order order : {Order::input, Order::colour}) {
     SCOPED_TRACE(std::string(type_name<T>()) + (pile_scene ? " pile " : " debris ") + to_string(order));
     SolverOptions base = options_for(Path::scalar, 1);
-    base.order = order;
     base.passes = 5;
     base.iteration = Iteration::accumulate;
     base.layout = BodyLayout::soa;
-    const auto [want_bodies, want_j] = solved(scene, Model::rigid, base);
+    const auto [want_bodies, want_j] = solved(scene, Model::rigid, base, order);
     for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
       if (!isa_supported(isa)) continue;
       for (const int threads : {1, 2, 3}) {
@@ -117,11 +115,10 @@ void expect_same_bits_everywhere(const Scene<T>& scene, bool pile_scene) {
           SCOPED_TRACE(std::string(to_string(isa)) + " " + std::to_string(threads) + " threads " + to_string(layout));
           SolverOptions o = options_for(Path::simd, threads, 64);
           o.isa = isa;
-          o.order = order;
           o.passes = base.passes;
           o.iteration = Iteration::accumulate;
           o.layout = layout;
-          const auto [bodies, j] = solved(scene, Model::rigid, o);
+          const auto [bodies, j] = solved(scene, Model::rigid, o, order);
           EXPECT_TRUE(same_impulses(j, want_j));
           EXPECT_TRUE(same_bodies(bodies, want_bodies));
         }
@@ -186,14 +183,13 @@ TEST(Iteration, AColumnOfBoxesGetsTheSupportImpulses) {
   for (const Order order : {Order::input, Order::colour}) {
     SCOPED_TRACE(to_string(order));
     SolverOptions o;
-    o.order = order;
     // K is the column's tridiagonal 2, -1 (1 at the ground), whose
     // Gauss-Seidel passes contract by about cos(pi / (2n + 1))^2 each
     // (0.9942 for 20 contacts): 4000 passes leave under 1e-10 of the error.
     o.passes = 4000;
     o.iteration = Iteration::accumulate;
     SolveStats stats;
-    const auto [bodies, j] = solved(scene, Model::rigid, o, &stats);
+    const auto [bodies, j] = solved(scene, Model::rigid, o, order, &stats);
     EXPECT_LT(stats.residual, 1e-9);
     const auto jv = j.view();
     for (std::size_t i = 0; i < kBoxes; ++i) {
@@ -286,18 +282,17 @@ TEST(Iteration, TheResidualIsTheLastPassesChangeOverTheLargestImpulse) {
   for (const Iteration iteration : {Iteration::repeat, Iteration::accumulate}) {
     SCOPED_TRACE(to_string(iteration));
     SolverOptions o = options_for(Path::simd, 2, 256);
-    o.order = Order::colour;
     o.iteration = iteration;
     SolveStats one;
-    (void)solved(scene, Model::rigid, o, &one);
+    (void)solved(scene, Model::rigid, o, Order::colour, &one);
     EXPECT_EQ(one.residual, 1.0);
     double last = 2;
     for (const int passes : {2, 4, 16}) {
       o.passes = passes - 1;
-      const auto [b0, before] = solved(scene, Model::rigid, o);
+      const auto [b0, before] = solved(scene, Model::rigid, o, Order::colour);
       o.passes = passes;
       SolveStats stats;
-      const auto [b1, after] = solved(scene, Model::rigid, o, &stats);
+      const auto [b1, after] = solved(scene, Model::rigid, o, Order::colour, &stats);
       double change = 0;
       double total = 0;
       const auto x = before.view();

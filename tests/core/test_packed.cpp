@@ -232,7 +232,7 @@ Scene<float> grouped_by_level(Scene<float> scene) {
   out.bodies = scene.bodies;
   out.contacts.resize(scene.contacts.size());
   for (std::size_t i = 0; i < scene.contacts.size(); ++i) {
-    out.contacts.set(i, scene.contacts.record(schedule.order()[i]));
+    out.contacts.set(i, scene.contacts.record(schedule.solve_order()[i]));
   }
   return out;
 }

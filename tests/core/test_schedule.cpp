@@ -85,7 +85,7 @@ Schedule build(const Scene<double>& s) {
 
 /// The contacts of batch k, in schedule order.
 std::vector<std::uint32_t> batch(const Schedule& s, std::size_t k) {
-  return {s.order() + s.batch_begin(k), s.order() + s.batch_begin(k + 1)};
+  return {s.solve_order() + s.batch_begin(k), s.solve_order() + s.batch_begin(k + 1)};
 }
 
 TEST(Schedule, ChainNeedsOneBatchPerContact) {

@@ -135,7 +135,6 @@ void check_reuse_allocates_nothing(const Scene<T>& original, std::initializer_li
         half_schedule.build(half, bodies);
 
         SolverOptions options;
-        options.order = order;
         options.passes = passes;
         options.layout = layout;
         const Solver solver(options);
@@ -189,9 +188,7 @@ TEST(SolverAllocations, ASecondSolveAllocatesNothingInDouble) { check_reuse_allo
 TEST(SolverAllocations, TheOneShotSolveReportsItsAllocatePhase) {
   Scene<float> scene = pile<float>();
   ImpulseBuffer<float> impulses(scene.contacts.size());
-  SolverOptions options;
-  options.order = Order::colour;
-  const SolveStats stats = solve(scene.bodies.view(), scene.contacts.view(), impulses.view(), options);
+  const SolveStats stats = solve(scene.bodies.view(), scene.contacts.view(), impulses.view(), {}, Order::colour);
   EXPECT_TRUE(std::isfinite(stats.allocate_seconds));
   EXPECT_GT(stats.allocate_seconds, 0.0);
 }

@@ -39,15 +39,16 @@
 namespace collide::test {
 namespace {
 
-/// A solve of a copy of `scene`'s bodies with `options`, from the J in
-/// `warm` (a warm start when options.warm_start).
+/// A solve of a copy of `scene`'s bodies with `options` on a schedule in
+/// `order`, from the J in `warm` (a warm start when options.warm_start).
 template <class T>
 std::pair<BodyBuffer<T>, ImpulseBuffer<T>> solved_from(const Scene<T>& scene, const ImpulseBuffer<T>& warm,
-                                                       const SolverOptions& options, SolveStats* stats = nullptr) {
+                                                       const SolverOptions& options, Order order = Order::input,
+                                                       SolveStats* stats = nullptr) {
   BodyBuffer<T> bodies = scene.bodies;
   const ContactView<T> c = scene.contacts.view();
   ImpulseBuffer<T> j = warm;
-  Schedule schedule(options.order);
+  Schedule schedule(order);
   schedule.build(c, bodies.view(), options.threads);
   const SolveStats s = Solver(options).solve(Model::rigid, bodies.view(), c, j.view(), schedule);
   if (stats != nullptr) *stats = s;
@@ -75,16 +76,14 @@ void expect_same_bits_everywhere(const Scene<T>& scene, const char* what) {
   for (const Order order : {Order::input, Order::colour}) {
     // The warm start: J of 4 cold passes on the same input.
     SolverOptions cold = accumulating(Path::scalar, 1, 4, false);
-    cold.order = order;
     const ImpulseBuffer<T> zero(scene.contacts.size());
-    const ImpulseBuffer<T> warm = solved_from(scene, zero, cold).second;
+    const ImpulseBuffer<T> warm = solved_from(scene, zero, cold, order).second;
     for (const int passes : {1, 3}) {
       SCOPED_TRACE(std::string(type_name<T>()) + " " + what + " " + to_string(order) + " " + std::to_string(passes) +
                    " passes");
       SolverOptions base = accumulating(Path::scalar, 1, passes, true);
-      base.order = order;
       base.layout = BodyLayout::soa;
-      const auto [want_bodies, want_j] = solved_from(scene, warm, base);
+      const auto [want_bodies, want_j] = solved_from(scene, warm, base, order);
       for (const Isa isa : {Isa::sse2, Isa::avx2, Isa::avx512}) {
         if (!isa_supported(isa)) continue;
         for (const int threads : {1, 2, 3}) {
@@ -92,9 +91,8 @@ void expect_same_bits_everywhere(const Scene<T>& scene, const char* what) {
             SCOPED_TRACE(std::string(to_string(isa)) + " " + std::to_string(threads) + " threads " + to_string(layout));
             SolverOptions o = accumulating(Path::simd, threads, passes, true);
             o.isa = isa;
-            o.order = order;
             o.layout = layout;
-            const auto [bodies, j] = solved_from(scene, warm, o);
+            const auto [bodies, j] = solved_from(scene, warm, o, order);
             EXPECT_TRUE(same_impulses(j, want_j));
             EXPECT_TRUE(same_bodies(bodies, want_bodies));
           }
@@ -165,8 +163,7 @@ TEST(WarmStart, AConvergedColumnStaysConvergedInOnePass) {
   for (const Order order : {Order::input, Order::colour}) {
     SCOPED_TRACE(to_string(order));
     SolverOptions o = accumulating(Path::simd, 2, 4000, false);
-    o.order = order;
-    const ImpulseBuffer<double> converged = solved_from(scene, zero, o).second;
+    const ImpulseBuffer<double> converged = solved_from(scene, zero, o, order).second;
     ASSERT_LT(support_error(converged, fall), 1e-9);
     // The next frame: the boxes at rest after the frame before, and one step
     // of gravity, fall again: the same input, warm-started.
@@ -175,13 +172,13 @@ TEST(WarmStart, AConvergedColumnStaysConvergedInOnePass) {
       o.passes = passes;
       o.warm_start = true;
       SolveStats warm_stats;
-      const auto [bodies, j] = solved_from(scene, converged, o, &warm_stats);
+      const auto [bodies, j] = solved_from(scene, converged, o, order, &warm_stats);
       EXPECT_LT(support_error(j, fall), 1e-9);
       EXPECT_LT(warm_stats.residual, 1e-9);
       for (std::size_t b = 1; b <= kBoxes; ++b) EXPECT_NEAR(bodies.view().v.y[b], 0.0, 1e-9 * fall) << "box " << b;
       o.warm_start = false;
       SolveStats cold_stats;
-      const ImpulseBuffer<double> cold = solved_from(scene, zero, o, &cold_stats).second;
+      const ImpulseBuffer<double> cold = solved_from(scene, zero, o, order, &cold_stats).second;
       EXPECT_GT(support_error(cold, fall), 0.1);
       EXPECT_GT(cold_stats.residual, 0.01);
     }
@@ -254,7 +251,7 @@ void expect_refused(ImpulseBuffer<T> warm, std::size_t bad, const std::string& w
   const ContactView<T> c = scene.contacts.view();
   const ImpulseBuffer<T> given = warm;
   const SolverOptions o = accumulating(Path::simd, threads, 2, true);
-  Schedule schedule(o.order);
+  Schedule schedule;
   schedule.build(c, bodies.view());
   try {
     (void)Solver(o).solve(bodies.view(), c, warm.view(), schedule);

@@ -85,7 +85,6 @@ TEST_P(PassBound, HoldsForTheSolveAndFailsForAWrongJ) {
   Schedule schedule(param.order);
   schedule.build(contacts, bodies.view());
   SolverOptions o;
-  o.order = param.order;
   o.passes = param.passes;
   o.iteration = param.iteration;
   o.threads = 2;
@@ -111,7 +110,7 @@ TEST_P(PassBound, HoldsForTheSolveAndFailsForAWrongJ) {
   std::vector<ReferenceContact<long double>> diag(contacts.count);
   reference_solve<long double>(
       ref_bodies.view(), ref_contacts.view(), ref_j.view(), diag.data(),
-      SolveSequence{schedule.order(), static_cast<std::size_t>(param.passes), param.iteration, param.warm});
+      SolveSequence{schedule.solve_order(), static_cast<std::size_t>(param.passes), param.iteration, param.warm});
   const ImpulseView<const long double> ref = std::as_const(ref_j).view();
 
   const ImpulseCheck solved = check_impulses<float>(std::as_const(j).view(), ref, diag);

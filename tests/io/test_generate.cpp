@@ -812,7 +812,7 @@ TEST(ChainScene, ScheduleIsOneBatchPerContact) {
   // Batch k is contact k: the law runs through the staircase in chain order.
   for (std::size_t k = 0; k < schedule.batch_count(); ++k) {
     ASSERT_EQ(schedule.batch_begin(k), k);
-    ASSERT_EQ(schedule.order()[k], k);
+    ASSERT_EQ(schedule.solve_order()[k], k);
   }
   auto f = collide::generate_chain<float>(1000, {7, false, collide::Model::particle});
   collide::Schedule float_schedule;

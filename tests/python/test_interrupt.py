@@ -60,11 +60,11 @@ def test_ctrl_c_stops_a_long_solve_on_a_whole_pass(order, layout):
     before = copy_bodies(bodies)
     target = collide.pack(bodies, "rigid") if layout == "packed" else bodies
     out = np.full((3, len(contacts)), np.nan, dtype=np.float32)
-    solver = collide.Solver(order=order, passes=1_000_000)  # tens of minutes to the end
+    solver = collide.Solver(passes=1_000_000)  # tens of minutes to the end
     timer = sigint_after(0.3)
     start = time.monotonic()
     with pytest.raises(KeyboardInterrupt) as stop:
-        solver.solve(target, contacts, out=out)
+        solver.solve(target, contacts, order=order, out=out)
     elapsed = time.monotonic() - start
     timer.join()
     assert elapsed < 5, elapsed
@@ -84,12 +84,12 @@ def test_ctrl_c_stops_a_long_solve_on_a_whole_pass(order, layout):
 def test_a_solver_stopped_once_solves_every_pass_next_time():
     bodies, contacts = collide.generate("pile", 16, dtype=np.float32)
     passes = max(50, int(2.0 / seconds_per_pass(bodies, contacts, "colour")))  # about two seconds
-    solver = collide.Solver(order="colour", passes=passes)
+    solver = collide.Solver(passes=passes)
     timer = sigint_after(0.1)
     with pytest.raises(KeyboardInterrupt, match=STOPPED.pattern):
-        solver.solve(copy_bodies(bodies), contacts)
+        solver.solve(copy_bodies(bodies), contacts, order="colour")
     timer.join()
-    _, stats = solver.solve(copy_bodies(bodies), contacts)
+    _, stats = solver.solve(copy_bodies(bodies), contacts, order="colour")
     assert stats["passes"] == passes
 
 

@@ -97,14 +97,20 @@ def test_order_color_is_named():
         collide.Schedule(bodies, contacts, order="color")
 
 
-def test_a_schedule_of_another_order_is_explained_in_python():
+def test_an_order_beside_a_schedule_is_explained_in_python():
+    # The schedule owns the order: a call takes one or the other.
     bodies, contacts = collide.generate("pile", 4, dtype=np.float64)
     schedule = collide.Schedule(bodies, contacts)
-    with pytest.raises(ValueError) as e:
-        collide.Solver(order="colour").solve(bodies, contacts, schedule=schedule)
-    assert str(e.value) == ("schedule is in input order but the solver's order is 'colour': build it as "
-                            "collide.Schedule(bodies, contacts, order=\"colour\")")
-    assert "collide::" not in str(e.value)
+    for call, name in ((lambda **k: collide.Solver().solve(bodies, contacts, **k), "solve"),
+                       (lambda **k: collide.solve(bodies, contacts, **k), "solve"),
+                       (lambda **k: collide.reference_solve(bodies, contacts, **k), "reference_solve")):
+        for order in ("input", "colour"):
+            with pytest.raises(ValueError) as e:
+                call(order=order, schedule=schedule)
+            assert str(e.value) == (f"{name}: give order= or schedule=, not both: a schedule runs in the order it "
+                                    "was built in (this one: 'input')")
+    with pytest.raises(TypeError, match="order must be 'input', 'colour' or None"):
+        collide.solve(bodies, contacts, order=1)
 
 
 def test_save_creates_the_folder(tmp_path):
@@ -137,7 +143,7 @@ def test_every_public_type_says_what_it_holds():
         "PackedBodies": repr(packed),
         "Islands": repr(collide.islands(bodies, contacts)),
         "Reference": repr(collide.reference_solve(bodies, contacts)),
-        "Solver": repr(collide.Solver(order="colour", passes=2, isa="sse2")),
+        "Solver": repr(collide.Solver(passes=2, isa="sse2")),
         "Schedule": repr(collide.Schedule(bodies, contacts, order="colour")),
         "ThreadLimit": repr(collide._collide.ThreadLimit(2)),
     }
@@ -156,8 +162,8 @@ def test_every_public_type_says_what_it_holds():
                                                            "the largest, island 0, has 1 contact)")
     assert reprs["Reference"] == (f"collide.Reference({m} contacts, {n} bodies, of a float32 scene: J, v, w and "
                                   "impulse_scale in float64)")
-    assert reprs["Solver"] == ("collide.Solver(path='simd', threads=0, isa='sse2', accuracy='fast', order='colour', "
-                               "passes=2, iteration='repeat')")
+    assert reprs["Solver"] == ("collide.Solver(path='simd', threads=0, isa='sse2', accuracy='fast', passes=2, "
+                               "iteration='repeat')")
     assert re.fullmatch(rf"collide\.Schedule\({m} contacts, {n} bodies, order 'colour': \d+ batch(es)?, the largest "
                         r"\d+ contacts?, \d+ colours?, \d+ overflow contacts?\)", reprs["Schedule"]), reprs["Schedule"]
     by_input = repr(collide.Schedule(bodies, contacts))

@@ -39,7 +39,7 @@ def test_passes_are_that_many_solves_added():
         again = collide.Bodies(*(np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q, bodies.p,
                                                        bodies.v, bodies.w)))
         J4, _ = collide.solve(bodies, contacts, order=order, passes=4)
-        solver = collide.Solver(order=order)
+        solver = collide.Solver()
         schedule = collide.Schedule(again, contacts, order=order)
         total = None
         for _ in range(4):
@@ -69,6 +69,24 @@ def test_reference_replays_the_solve_order():
     np.testing.assert_array_equal(by_schedule.J, by_name.J)
 
 
+def test_one_solver_runs_each_schedule_in_its_order():
+    # The schedule owns the order: one Solver gives each order's bits.
+    bodies, contacts = collide.generate("pile", 8, dtype=np.float32)
+    solver = collide.Solver()
+    seen = {}
+    for order in ("colour", "input", "colour"):
+        copy = collide.Bodies(*(np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q, bodies.p,
+                                                      bodies.v, bodies.w)))
+        J, stats = solver.solve(copy, contacts, schedule=collide.Schedule(copy, contacts, order=order))
+        want, _ = collide.solve(collide.Bodies(*(np.array(a) for a in (bodies.inv_mass, bodies.inv_inertia, bodies.q,
+                                                                       bodies.p, bodies.v, bodies.w))),
+                                contacts, order=order)
+        assert stats["order"] == order
+        np.testing.assert_array_equal(bits(J), bits(want))
+        seen[order] = J
+    assert not np.array_equal(bits(seen["input"]), bits(seen["colour"]))
+
+
 def test_schedule_describes_its_order():
     bodies, contacts = collide.generate("pile", 10, dtype=np.float64)
     s = collide.Schedule(bodies, contacts, order="colour")
@@ -81,8 +99,8 @@ def test_schedule_describes_its_order():
 def test_mismatched_orders_and_bad_values_are_refused():
     bodies, contacts = collide.generate("pile", 6, dtype=np.float64)
     schedule = collide.Schedule(bodies, contacts)
-    with pytest.raises(ValueError, match=r"build it as collide\.Schedule\(bodies, contacts, order=\"colour\"\)$"):
-        collide.Solver(order="colour").solve(bodies, contacts, schedule=schedule)
+    with pytest.raises(ValueError, match=r"give order= or schedule=, not both"):
+        collide.Solver().solve(bodies, contacts, order="colour", schedule=schedule)
     with pytest.raises(ValueError, match="expected input or colour"):
         collide.solve(bodies, contacts, order="color")
     with pytest.raises(ValueError, match="passes must be an integer from 1 to 1000000, got 0"):

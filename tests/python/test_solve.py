@@ -238,7 +238,7 @@ def test_allocate_seconds_apart_from_the_kernel(dtype):
     assert stats["allocate_seconds"] > 0, stats
     assert "'allocate_seconds': " in repr(stats)
     # A reused solver finds its buffers sized: nothing to allocate.
-    solver = collide.Solver(order="colour")
+    solver = collide.Solver()
     schedule = collide.Schedule(bodies, contacts, order="colour")
     _, first = solver.solve(bodies, contacts, schedule=schedule)
     _, second = solver.solve(bodies, contacts, schedule=schedule)

@@ -22,11 +22,13 @@
 
 namespace collide::test {
 
-/// Builds a schedule and runs one Solver with `options` on the bodies in place.
+/// Builds a schedule in `order` and runs one Solver with `options` on the
+/// bodies in place.
 template <class T>
-ImpulseBuffer<T> kernel_solve(BodyBuffer<T>& bodies, const ContactView<T>& contacts, const SolverOptions& options) {
+ImpulseBuffer<T> kernel_solve(BodyBuffer<T>& bodies, const ContactView<T>& contacts, const SolverOptions& options,
+                              Order order = Order::input) {
   ImpulseBuffer<T> j(contacts.count);
-  Schedule schedule(options.order);
+  Schedule schedule(order);
   schedule.build(contacts, bodies.view());
   Solver(options).solve(bodies.view(), contacts, j.view(), schedule);
   return j;

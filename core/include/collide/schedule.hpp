@@ -7,7 +7,7 @@
 // at once, contacts are grouped into batches in which no movable body appears
 // twice; the batches run one after another, the contacts inside a batch in
 // any order and on any lane or thread. The result is the law applied
-// sequentially in order(), the same bits for every thread count. Two orders
+// sequentially in solve_order(), the same bits for every thread count. Two orders
 // exist (docs/collision-law.md, "The solve order"):
 //
 // Order::input, the level schedule: contact k goes to the batch one past the
@@ -60,7 +60,7 @@
 // are immovable: a solver keeps one across frames while the contact set holds
 // and rebuilds it when a or b change.
 //
-// Memory: 4 bytes per contact for order(), 5 per batch, and scratch kept
+// Memory: 4 bytes per contact for solve_order(), 5 per batch, and scratch kept
 // between builds, so a schedule rebuilt for a scene of the same size does
 // not allocate: input order 1 byte per contact and per body (5 and 5 for a
 // scene of 254 batches or more), colour order 1 byte per contact and 4 per
@@ -110,7 +110,7 @@ class Schedule {
   Schedule(Schedule&& other) noexcept;
   Schedule& operator=(Schedule&& other) noexcept;
 
-  /// Builds the schedule in ordering()'s order. Bodies with inv_mass == 0
+  /// Builds the schedule in order(). Bodies with inv_mass == 0
   /// do not conflict. `bodies` is any body view (BodyView, SphereView,
   /// ParticleView): only its count and inverse masses are read. `threads`:
   /// at most this many threads; 0 means the concurrency of the calling
@@ -149,19 +149,20 @@ class Schedule {
     build_strided(contacts, bodies.count, static_cast<const T*>(bodies.inv_mass), 1, threads);
   }
 
-  /// The order this schedule is built in.
-  [[nodiscard]] Order ordering() const { return ordering_; }
+  /// The order this schedule is built in: the one owner of the choice. A
+  /// Solver runs whatever schedule it is given in the schedule's order.
+  [[nodiscard]] Order order() const { return order_; }
   /// Number of contacts the schedule was built for.
   [[nodiscard]] std::size_t contact_count() const { return contact_count_; }
   /// Number of bodies the schedule was built for.
   [[nodiscard]] std::size_t body_count() const { return body_count_; }
   /// Number of batches; batches run in order.
   [[nodiscard]] std::size_t batch_count() const { return batch_count_; }
-  /// Contacts of batch k are order()[batch_begin(k)] .. order()[batch_begin(k+1) - 1].
+  /// Contacts of batch k are solve_order()[batch_begin(k)] .. solve_order()[batch_begin(k+1) - 1].
   [[nodiscard]] std::size_t batch_begin(std::size_t k) const { return batch_begin_[k]; }
   /// Contact indices, grouped by batch, ascending inside each batch: the
-  /// solve order.
-  [[nodiscard]] const std::uint32_t* order() const { return order_; }
+  /// solve order (contact_count() of them).
+  [[nodiscard]] const std::uint32_t* solve_order() const { return solve_order_; }
   /// True when batch k holds consecutive contacts, so that contact arrays can
   /// be loaded as vectors rather than gathered (a scene with no shared movable
   /// body is one such batch).
@@ -192,7 +193,7 @@ class Schedule {
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  Order ordering_ = Order::input;
+  Order order_ = Order::input;
   std::size_t contact_count_ = 0;
   std::size_t body_count_ = 0;
   std::size_t batch_count_ = 0;
@@ -200,7 +201,7 @@ class Schedule {
   std::size_t conflicts_ = 0;
   std::size_t colours_ = 0;
   std::size_t overflow_contacts_ = 0;
-  const std::uint32_t* order_ = nullptr;
+  const std::uint32_t* solve_order_ = nullptr;
   const std::uint32_t* batch_begin_ = nullptr;
   const std::uint8_t* contiguous_ = nullptr;
 };

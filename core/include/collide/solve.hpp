@@ -24,8 +24,11 @@ namespace collide {
 
 /// How a Solver runs. The kinds of its choices stand beside what they choose
 /// between: Path and Isa in collide/isa.hpp, Accuracy in
-/// collide/accuracy.hpp, BodyLayout in collide/packed.hpp, Order in
-/// collide/schedule.hpp and Iteration in collide/iteration.hpp.
+/// collide/accuracy.hpp, BodyLayout in collide/packed.hpp and Iteration in
+/// collide/iteration.hpp. The order contacts that share movable bodies are
+/// applied in is not among them: the schedule owns it (Schedule(Order),
+/// collide/schedule.hpp), and a solve runs in the order of the schedule it
+/// is given.
 struct SolverOptions {
   Path path = Path::simd;
   /// Worker threads; 0 means every hardware thread. Results do not depend on
@@ -48,12 +51,6 @@ struct SolverOptions {
   /// For SoA input: automatic packs it when that is faster (Solver::solve),
   /// soa never packs, packed always packs. Ignored for packed input.
   BodyLayout layout = BodyLayout::automatic;
-  /// The order contacts that share movable bodies are applied in
-  /// (schedule.hpp): each schedule a Solver is given must have been built in
-  /// it (Schedule(order)); the one-shot collide::solve() builds it so.
-  /// Order::input is the law in input order; Order::colour an order collide
-  /// chooses, several times faster on piles, stacks and chains.
-  Order order = Order::input;
   /// Times the contacts are resolved in the schedule's order, each pass the
   /// law as the velocities stand (>= 1). J is the sum over the passes, the
   /// same bits as that many solves with their J added in turn (every NaN
@@ -124,7 +121,7 @@ struct SolveStats {
   double allocate_seconds = 0;
   BodyLayout layout = BodyLayout::soa;  ///< the layout the kernel ran on (never automatic)
   Accuracy accuracy = Accuracy::fast;
-  Order order = Order::input;         ///< the schedule's order
+  Order order = Order::input;         ///< the schedule's order (Schedule::order())
   std::size_t colours = 0;            ///< the colour order: Schedule::colours()
   std::size_t overflow_contacts = 0;  ///< the colour order: Schedule::overflow_contacts()
   /// Passes run: SolverOptions::passes, or fewer when SolverOptions::stop
@@ -250,13 +247,13 @@ class Solver {
 };
 
 /// One-shot convenience: checks the input with validate() first, then builds
-/// a schedule and a solver and solves with the cheapest model that fits
-/// (choose_model()). Input that validate() rejects throws
+/// a schedule in `order` and a solver and solves with the cheapest model
+/// that fits (choose_model()). Input that validate() rejects throws
 /// std::invalid_argument carrying validate()'s message ("collide::solve:
 /// contacts.b[17] = 40: out of range (8 bodies)") and nothing is written;
 /// options the Solver refuses throw as its constructor does.
 template <class T>
 SolveStats solve(const BodyView<T>& bodies, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                 const SolverOptions& options = {});
+                 const SolverOptions& options = {}, Order order = Order::input);
 
 }  // namespace collide

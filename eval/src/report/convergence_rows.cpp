@@ -146,12 +146,11 @@ float largest_impulse(const ImpulseBuffer<float>& impulses) {
   return largest;
 }
 
-SolverOptions convergence_options(int threads, Order order, Iteration iteration, int passes, bool warm) {
+SolverOptions convergence_options(int threads, Iteration iteration, int passes, bool warm) {
   SolverOptions o;
   o.path = Path::simd;
   o.isa = default_isa();
   o.threads = threads;
-  o.order = order;
   o.iteration = iteration;
   o.passes = passes;
   o.warm_start = warm;
@@ -174,12 +173,12 @@ class SceneRows {
       for (const Iteration iteration : {Iteration::repeat, Iteration::accumulate}) {
         for (const int passes : kPasses) {
           progress(what(order, iteration, passes, false));
-          measure(schedule, convergence_options(threads_, order, iteration, passes, false), warm_);
+          measure(schedule, convergence_options(threads_, iteration, passes, false), warm_);
         }
       }
       for (const int passes : kWarmPasses) {
         progress(what(order, Iteration::accumulate, passes, true));
-        measure(schedule, convergence_options(threads_, order, Iteration::accumulate, passes, true), warm_);
+        measure(schedule, convergence_options(threads_, Iteration::accumulate, passes, true), warm_);
       }
     }
   }
@@ -196,7 +195,7 @@ class SceneRows {
   void converged() {
     Schedule schedule(Order::colour);
     schedule.build(scene_.contacts.view(), scene_.bodies.size(), scene_.bodies.view().inv_mass);
-    const Solver solver(convergence_options(threads_, Order::colour, Iteration::accumulate, kConvergedPasses, false));
+    const Solver solver(convergence_options(threads_, Iteration::accumulate, kConvergedPasses, false));
     BodyBuffer<float> bodies = scene_.bodies;
     warm_.resize(scene_.contacts.size());
     warm_residual_ = solver.solve(Model::rigid, bodies.view(), scene_.contacts.view(), warm_.view(), schedule).residual;
@@ -220,7 +219,7 @@ class SceneRows {
 
     ConvergenceRow row;
     row.scene = name_;
-    row.order = to_string(options.order);
+    row.order = to_string(schedule.order());
     row.iteration = to_string(options.iteration);
     row.passes = options.passes;
     row.warm = options.warm_start;
@@ -235,7 +234,7 @@ class SceneRows {
     row.start_residual = options.warm_start ? warm_residual_ : 1;
 
     const float largest = largest_impulse(j);
-    const Solver next(convergence_options(threads_, options.order, Iteration::repeat, 1, false));
+    const Solver next(convergence_options(threads_, Iteration::repeat, 1, false));
     ImpulseBuffer<float> more(contacts.count);
     next.solve(Model::rigid, bodies.view(), contacts, more.view(), schedule);
     row.next_pass = largest > 0 ? static_cast<double>(largest_impulse(more)) / largest : 0;

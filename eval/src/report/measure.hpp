@@ -30,7 +30,7 @@ struct ReferenceResult {
   MomentumTotals before, after;  ///< collide/eval/conservation.hpp
 };
 /// Solves convert_scene<long double>(sample) with reference_solve<long double>,
-/// in input order or in `order` (a solve's Schedule::order()).
+/// in input order or in `order` (a solve's Schedule::solve_order()).
 template <class T>
 ReferenceResult reference_of(const Scene<T>& sample, const std::uint32_t* order = nullptr);
 

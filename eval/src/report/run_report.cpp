@@ -247,13 +247,12 @@ void sweep_points(const Solver& s, Model model, Scene<float>& scene, const std::
 }
 
 /// The options of a kernel row's Solver.
-SolverOptions kernel_options(Path path, int threads, Isa isa, Accuracy accuracy, Order order = Order::input) {
+SolverOptions kernel_options(Path path, int threads, Isa isa, Accuracy accuracy) {
   SolverOptions options;
   options.path = path;
   options.threads = threads;
   options.isa = isa;
   options.accuracy = accuracy;
-  options.order = order;
   return options;
 }
 
@@ -320,11 +319,10 @@ class Runner {
     return rows;
   }
 
-  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy, Order order = Order::input) {
-    auto& slot = solvers_[{(path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) +
-                               (accuracy == Accuracy::accurate ? 16 : 0) + (order == Order::colour ? 32 : 0),
-                           threads}];
-    if (!slot) slot = std::make_unique<Solver>(kernel_options(path, threads, isa, accuracy, order));
+  const Solver& solver(Path path, int threads, Isa isa, Accuracy accuracy) {
+    auto& slot = solvers_[{
+        (path == Path::simd ? 1 : 0) + 2 * static_cast<int>(isa) + (accuracy == Accuracy::accurate ? 16 : 0), threads}];
+    if (!slot) slot = std::make_unique<Solver>(kernel_options(path, threads, isa, accuracy));
     return *slot;
   }
 
@@ -460,9 +458,9 @@ class Runner {
                          ImpulseBuffer<T>& impulses) {
     const std::string what = std::string(scene_name(kind)) + " " + precision_name<T>() + (friction ? " friction" : "");
     progress_->show(what + ": long double reference of the " + to_string(model) + " sample in the colour order");
-    const ReferenceResult reference = reference_of(sample, sample_schedule.order());
+    const ReferenceResult reference = reference_of(sample, sample_schedule.solve_order());
     for (const int threads : config_.threads) {
-      const Solver& s = solver(Path::simd, threads, default_isa(), Accuracy::fast, Order::colour);
+      const Solver& s = solver(Path::simd, threads, default_isa(), Accuracy::fast);
       ReportRow row = new_row(kind, "simd", model, precision_name<T>(), friction, threads, scene.contacts.size(),
                               sample.contacts.size());
       row.simd = true;

@@ -53,7 +53,7 @@ struct ReferenceContact {
 };
 
 /// The sequence in which a solve applies the law: the contacts in `order`
-/// (contact indices, each once: a solve's Schedule::order()), or in input
+/// (contact indices, each once: a solve's Schedule::solve_order()), or in input
 /// order when it is null; `passes` times over (SolverOptions::passes), J
 /// summed over the passes or, with Iteration::accumulate, the totals the
 /// passes accumulated (SolverOptions::iteration).
