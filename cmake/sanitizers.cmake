@@ -19,6 +19,14 @@
 #     build takes longer, for no extra findings. The level is applied after the build type's flags, so it wins.
 #     Configure sanitizer builds as Debug: NDEBUG stays undefined and the
 #     kernels' debug asserts (index range, a != b, view sizes) run too.
+#   * The kernel units (core/src/kernel/) leave out UBSan's pointer-overflow
+#     check (COLLIDE_KERNEL_SANITIZE_OPTIONS): it guards every address the
+#     inlined lane loads and stores form, and half of those units' compile
+#     time under the sanitizers goes to it (decision 0044). What it would
+#     catch there, an address that wraps, needs an index beyond the arrays,
+#     and ASan checks every access against its allocation; the kernels'
+#     indices are checked against the counts before a solve (Schedule::build,
+#     validate_indices) and asserted in these Debug builds.
 #   * float-divide-by-zero is not part of "undefined" in GCC or Clang, and is
 #     not enabled: IEEE division by zero is defined, and the kernel divides by
 #     zero in lanes whose result it discards (see contact_kernel.hpp).
@@ -34,6 +42,9 @@ if(COLLIDE_SANITIZE)
   add_compile_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all -fno-omit-frame-pointer -g
                       ${COLLIDE_SANITIZE_OPT})
   add_link_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all)
+  if(_collide_sanitize MATCHES "undefined")
+    set(COLLIDE_KERNEL_SANITIZE_OPTIONS -fno-sanitize=pointer-overflow)
+  endif()
   if(_collide_sanitize MATCHES "thread")
     # TBB's hand-overs become visible to TSan through the ITT bridge (tests/tsan/,
     # built there with the race canary): the TBB headers notify spawn, join and

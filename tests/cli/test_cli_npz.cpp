@@ -405,6 +405,12 @@ TEST_F(CliNpzTest, ReportMeasuresAScenesFiles) {
                              path("missing.npz").string(), "--contacts", path("contacts.npz").string()});
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("missing.npz"), std::string::npos) << bad.err;
+  // The files are read before anything is measured: the run's first phase
+  // (phase_seconds lists the phases as they ran), so a bad one stops it at once.
+  const std::string text = slurp(path("r.json"));
+  const std::size_t phases = text.find("\"phase_seconds\": {");
+  ASSERT_NE(phases, std::string::npos);
+  EXPECT_EQ(text.compare(phases, 26, "\"phase_seconds\": {\"read\": "), 0) << text.substr(phases, 80);
 }
 
 }  // namespace

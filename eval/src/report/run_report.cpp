@@ -70,6 +70,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -277,6 +278,13 @@ class Runner {
       report_.phase_seconds.emplace_back(name, seconds_since(phase));
       phase = Clock::now();
     };
+    // The caller's files first: a file that cannot be read stops the report
+    // before any measurement, not minutes into it.
+    if (!config_.scene_bodies.empty()) {
+      file_double_ = read_file_scene<double>();
+      file_float_ = read_file_scene<float>();
+      end_phase("read");
+    }
     triad_ = measure_machine(config_, report_.machine, [&](const std::string& what) { progress_->show(what); });
     end_phase("triad");
     for (const SceneKind kind : {SceneKind::pairs, SceneKind::debris, SceneKind::pile}) {
@@ -287,8 +295,10 @@ class Runner {
       end_phase(scene_name(kind));
     }
     if (!config_.scene_bodies.empty()) {
-      run_file_scene<double>();
-      run_file_scene<float>();
+      run_file_scene(*file_double_);
+      file_double_.reset();
+      run_file_scene(*file_float_);
+      file_float_.reset();
       end_phase("file");
     }
     if (config_.convergence) {
@@ -377,10 +387,14 @@ class Runner {
   /// The caller's scene files: its own friction, and only the models it fits
   /// (its bodies are the caller's, not reshaped for a model).
   template <class T>
-  void run_file_scene() {
-    const std::string what = std::string("file ") + precision_name<T>();
-    progress_->show(what + ": reading " + config_.scene_bodies + " and " + config_.scene_contacts);
-    Scene<T> scene = read_scene_files<T>(config_.scene_bodies, config_.scene_contacts);
+  [[nodiscard]] Scene<T> read_file_scene() {
+    progress_->show(std::string("file ") + precision_name<T>() + ": reading " + config_.scene_bodies + " and " +
+                    config_.scene_contacts);
+    return read_scene_files<T>(config_.scene_bodies, config_.scene_contacts);
+  }
+
+  template <class T>
+  void run_file_scene(Scene<T>& scene) {
     const Scene<T> sample = contact_prefix(scene, sample_size());
     measure_scene(SceneKind::file, scene.contacts.view().mu != nullptr, scene, sample);
   }
@@ -609,6 +623,9 @@ class Runner {
   Report& report_;
   std::unique_ptr<Progress> progress_;
   std::map<int, double> triad_;
+  /// The caller's scene in each precision, read before anything is measured.
+  std::optional<Scene<double>> file_double_;
+  std::optional<Scene<float>> file_float_;
   std::map<std::pair<int, int>, std::unique_ptr<Solver>> solvers_;
 };
 
