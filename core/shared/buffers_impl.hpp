@@ -86,21 +86,22 @@ void check_contact(const char* where, std::size_t i, const ContactRecord<T>& con
 
 }  // namespace buffers_detail
 
+// The columns follow kRigidFields (collide/bodies.hpp): column K holds
+// field K, so every member below walks the table.
+
 template <class T>
 void BodyBuffer<T>::resize(std::size_t n) {
-  for (auto* v :
-       {&inv_mass_, &ix_, &iy_, &iz_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_, &wz_}) {
-    v->resize(n, T(0));
-  }
-  qw_.resize(n, T(1));
+  for_each_body_field<BodyView<T>>([&](auto at) {
+    using At = decltype(at);
+    // A new body is immovable, at rest, with the identity orientation.
+    const bool unit = At::field.member == BodyMember::q && At::field.component == 0;
+    columns_[At::index].resize(n, unit ? T(1) : T(0));
+  });
 }
 
 template <class T>
 void BodyBuffer<T>::reserve(std::size_t n) {
-  for (auto* v :
-       {&inv_mass_, &ix_, &iy_, &iz_, &qw_, &qx_, &qy_, &qz_, &px_, &py_, &pz_, &vx_, &vy_, &vz_, &wx_, &wy_, &wz_}) {
-    v->reserve(n);
-  }
+  for (Column& c : columns_) c.reserve(n);
 }
 
 template <class T>
@@ -115,71 +116,62 @@ void BodyBuffer<T>::set(std::size_t i, const BodyRecord<T>& body) {
   buffers_detail::check_body("collide::BodyBuffer::set", i, body);
   const T inv_m = buffers_detail::inverse_or_zero(body.m);
   const bool immovable = inv_m == T(0);
-  inv_mass_[i] = inv_m;
-  // The law: "a body with m = inf is immovable whatever its I".
-  ix_[i] = immovable ? T(0) : buffers_detail::inverse_or_zero(body.I[0]);
-  iy_[i] = immovable ? T(0) : buffers_detail::inverse_or_zero(body.I[1]);
-  iz_[i] = immovable ? T(0) : buffers_detail::inverse_or_zero(body.I[2]);
-  // q as given: the kernels normalise it, as the law says, in the precision
-  // of the accuracy mode (normalising here would round it for both).
-  qw_[i] = body.q[0];
-  qx_[i] = body.q[1];
-  qy_[i] = body.q[2];
-  qz_[i] = body.q[3];
-  px_[i] = body.p[0];
-  py_[i] = body.p[1];
-  pz_[i] = body.p[2];
-  vx_[i] = body.v[0];
-  vy_[i] = body.v[1];
-  vz_[i] = body.v[2];
-  wx_[i] = body.w[0];
-  wy_[i] = body.w[1];
-  wz_[i] = body.w[2];
+  for_each_body_field<BodyView<T>>([&](auto at) {
+    using At = decltype(at);
+    T& value = columns_[At::index][i];
+    if constexpr (At::field.member == BodyMember::inv_mass) {
+      value = inv_m;
+    } else if constexpr (At::field.member == BodyMember::inv_inertia) {
+      // The law: "a body with m = inf is immovable whatever its I".
+      value = immovable ? T(0) : buffers_detail::inverse_or_zero(body.I[At::field.component]);
+    } else {
+      // q (and p, v, w) as given: the kernels normalise q, as the law says,
+      // in the precision of the accuracy mode (normalising here would round
+      // it for both).
+      value = At::of(body);
+    }
+  });
 }
 
 template <class T>
 BodyRecord<T> BodyBuffer<T>::record(std::size_t i) const {
   BodyRecord<T> r;
-  r.m = buffers_detail::inverse_or_inf(inv_mass_[i]);
-  r.I[0] = buffers_detail::inverse_or_inf(ix_[i]);
-  r.I[1] = buffers_detail::inverse_or_inf(iy_[i]);
-  r.I[2] = buffers_detail::inverse_or_inf(iz_[i]);
-  r.q[0] = qw_[i];
-  r.q[1] = qx_[i];
-  r.q[2] = qy_[i];
-  r.q[3] = qz_[i];
-  r.p[0] = px_[i];
-  r.p[1] = py_[i];
-  r.p[2] = pz_[i];
-  r.v[0] = vx_[i];
-  r.v[1] = vy_[i];
-  r.v[2] = vz_[i];
-  r.w[0] = wx_[i];
-  r.w[1] = wy_[i];
-  r.w[2] = wz_[i];
+  for_each_body_field<BodyView<T>>([&](auto at) {
+    using At = decltype(at);
+    const T value = columns_[At::index][i];
+    if constexpr (At::field.member == BodyMember::inv_mass) {
+      r.m = buffers_detail::inverse_or_inf(value);
+    } else if constexpr (At::field.member == BodyMember::inv_inertia) {
+      r.I[At::field.component] = buffers_detail::inverse_or_inf(value);
+    } else {
+      At::of(r) = value;
+    }
+  });
   return r;
 }
 
+namespace buffers_detail {
+// The view of a buffer's columns, one per array of kRigidFields; U is T or const T.
+template <class U, class Columns>
+BodyView<U> column_view(Columns& columns) {
+  BodyView<U> b;
+  b.count = columns[0].size();
+  for_each_body_field<BodyView<U>>([&](auto at) {
+    using At = decltype(at);
+    At::of(b) = columns[At::index].data();
+  });
+  return b;
+}
+}  // namespace buffers_detail
+
 template <class T>
 BodyView<T> BodyBuffer<T>::view() {
-  return {size(),
-          inv_mass_.data(),
-          {ix_.data(), iy_.data(), iz_.data()},
-          {qw_.data(), qx_.data(), qy_.data(), qz_.data()},
-          {px_.data(), py_.data(), pz_.data()},
-          {vx_.data(), vy_.data(), vz_.data()},
-          {wx_.data(), wy_.data(), wz_.data()}};
+  return buffers_detail::column_view<T>(columns_);
 }
 
 template <class T>
 BodyView<const T> BodyBuffer<T>::view() const {
-  return {size(),
-          inv_mass_.data(),
-          {ix_.data(), iy_.data(), iz_.data()},
-          {qw_.data(), qx_.data(), qy_.data(), qz_.data()},
-          {px_.data(), py_.data(), pz_.data()},
-          {vx_.data(), vy_.data(), vz_.data()},
-          {wx_.data(), wy_.data(), wz_.data()}};
+  return buffers_detail::column_view<const T>(columns_);
 }
 
 template <class T>

@@ -56,7 +56,9 @@
 
 #include <limits>
 #include <type_traits>
+#include <utility>
 
+#include "collide/bodies.hpp"
 #include "exact_lanes.hpp"
 #include "lanes.hpp"
 
@@ -93,6 +95,20 @@ struct BodyLanes {
   Vec3<V> v;            // [m/s]
   Vec3<V> w;            // [rad/s] (sphere, rigid)
 };
+
+/// Calls f(BodyFieldAt<View, K>{}) for every field K of the model of View (a
+/// view or a packed record: collide/bodies.hpp's tables), unrolled at compile
+/// time and forced inline like the rest of the kernel. BodyFieldAt::of
+/// reaches the field's array in a view, its value in a record and its lane
+/// in BodyLanes alike.
+template <class View, class F, std::size_t... K>
+COLLIDE_LANE_INLINE void each_lane_field(F& f, std::index_sequence<K...> /*fields*/) {
+  (f(BodyFieldAt<View, K>{}), ...);
+}
+template <class View, class F>
+COLLIDE_LANE_INLINE void for_each_lane_field(F&& f) {
+  each_lane_field<View>(f, std::make_index_sequence<kFieldCount<View>>{});
+}
 
 /// The W contacts, gathered into lanes.
 template <class V>

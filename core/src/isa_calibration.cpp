@@ -127,36 +127,33 @@ class CalibrationScene {
       for (std::size_t i = kContacts - 1; i > 0; --i) std::swap(order_[i], order_[draw.below(i + 1)]);
     }
 
-    job_.model = model;
     job_.accurate = accuracy == Accuracy::accurate;
     job_.friction = false;
     job_.contacts = contacts_.view();
     job_.impulses = impulses_.view();
     job_.order = order_.data();
     const BodyView<T> soa = bodies_.view();
-    if (!scattered) {
-      job_.rigid = soa;
-      job_.sphere = sphere_view(soa);
-      job_.particle = particle_view(soa);
-    } else {
-      job_.packed = true;
-      switch (model) {
-        case Model::particle:
-          particle_records_.resize(count);
-          job_.packed_particle = packed_view(particle_records_);
-          pack(particle_view(soa), job_.packed_particle);
-          break;
-        case Model::sphere:
-          sphere_records_.resize(count);
-          job_.packed_sphere = packed_view(sphere_records_);
-          pack(sphere_view(soa), job_.packed_sphere);
-          break;
-        case Model::rigid:
-          rigid_records_.resize(count);
-          job_.packed_rigid = packed_view(rigid_records_);
-          pack(soa, job_.packed_rigid);
-          break;
+    // The SoA view of the model, or records packed from it for a scattered scene.
+    const auto use = [&](const auto& view, auto& records) {
+      if (scattered) {
+        records.resize(count);
+        const auto packed = packed_view(records);
+        pack(view, packed);
+        job_.bodies = packed;
+      } else {
+        job_.bodies = view;
       }
+    };
+    switch (model) {
+      case Model::particle:
+        use(particle_view(soa), particle_records_);
+        break;
+      case Model::sphere:
+        use(sphere_view(soa), sphere_records_);
+        break;
+      case Model::rigid:
+        use(soa, rigid_records_);
+        break;
     }
     saved_bodies_ = bodies_;
     saved_particle_ = particle_records_;

@@ -33,10 +33,10 @@ template <class T>
 JobKernels<T> job_kernels(const KernelTable& table, const KernelJob<T>& job, bool simd) {
   const KernelLoops<T>& loops = of_precision<T>(table.loops_float, table.loops_double);
   const GroupLoops<T>& one_lane = of_precision<T>(one_lane_table().loops_float, one_lane_table().loops_double);
-  const auto model = static_cast<std::size_t>(job.model);
+  const auto model = static_cast<std::size_t>(job.model());
   const std::size_t mode = job.accurate ? 1 : 0;
   const std::size_t friction = job.friction ? 1 : 0;
-  const std::size_t layout = job.packed ? 1 : 0;
+  const std::size_t layout = job.packed() ? 1 : 0;
   JobKernels<T> k;
   if (job.accumulates()) {
     // Runs of tiny batches take the one-lane loop contact by contact; the

@@ -40,6 +40,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <variant>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
@@ -98,24 +99,28 @@ struct AccumulatedView {
 /// the velocities the solve was given, or the totals applied to the bodies.
 enum class WarmVisit : std::uint8_t { none, targets, apply };
 
-/// Everything a kernel needs besides the range: the bodies in the view of
-/// `model` and layout (only that member is set), the contacts, where J goes,
-/// and the schedule's order.
+/// The bodies of a job: one of the six views, SoA or packed, of the three
+/// models, in the order of Model's values (particle, sphere, rigid) and SoA
+/// before packed, so that the alternative's index names the model and the
+/// layout (KernelJob::model, KernelJob::packed).
+template <class T>
+using JobBodies = std::variant<ParticleView<T>, SphereView<T>, BodyView<T>, PackedView<PackedParticle<T>>,
+                               PackedView<PackedSphere<T>>, PackedView<PackedRigid<T>>>;
+static_assert(static_cast<int>(Model::particle) == 0 && static_cast<int>(Model::sphere) == 1 &&
+                  static_cast<int>(Model::rigid) == 2,
+              "JobBodies lists the views in the order of Model's values");
+
+/// Everything a kernel needs besides the range: the bodies (in the view of
+/// their model and layout), the contacts, where J goes, and the schedule's
+/// order.
 template <class T>
 struct KernelJob {
-  Model model = Model::rigid;
+  JobBodies<T> bodies;
   bool friction = false;  ///< contacts.mu is set: run the Coulomb step
-  bool packed = false;    ///< the bodies are in a packed_* member, not a SoA view
   bool accurate = false;  ///< Accuracy::accurate: the law in wider lanes (exact_lanes.hpp)
   /// J is added to what the impulse arrays hold (the passes after the first,
   /// SolverOptions::passes) rather than written.
   bool accumulate = false;
-  BodyView<T> rigid;
-  SphereView<T> sphere;
-  ParticleView<T> particle;
-  PackedView<PackedRigid<T>> packed_rigid;
-  PackedView<PackedSphere<T>> packed_sphere;
-  PackedView<PackedParticle<T>> packed_particle;
   ContactView<T> contacts;
   ImpulseView<T> impulses;
   const std::uint32_t* order = nullptr;
@@ -133,6 +138,10 @@ struct KernelJob {
   WarmVisit warm = WarmVisit::none;
 
   [[nodiscard]] bool accumulates() const { return accumulated.normal != nullptr; }
+  /// The model of the bodies' view.
+  [[nodiscard]] Model model() const { return static_cast<Model>(bodies.index() % 3); }
+  /// True when the bodies are packed records, not SoA arrays.
+  [[nodiscard]] bool packed() const { return bodies.index() >= 3; }
 };
 
 /// Resolves order[begin, end) (all inside one batch; `contiguous` when the

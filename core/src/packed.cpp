@@ -35,139 +35,86 @@ void for_bodies(std::size_t count, F&& f) {
   });
 }
 
-/// A 3-vector of arrays, element i, into a record's three values and back.
-template <class T, class U>
-void get3(T (&to)[3], const Vec3Array<U>& from, std::size_t i) {
-  to[0] = from.x[i], to[1] = from.y[i], to[2] = from.z[i];
-}
-template <class T>
-void put3(const Vec3Array<T>& to, const T (&from)[3], std::size_t i) {
-  to.x[i] = from[0], to.y[i] = from[1], to.z[i] = from[2];
+}  // namespace
+
+// Every field of the model's table (collide/bodies.hpp), body by body. A
+// rigid view's inverse masses, kept beside the records, are copied between
+// the two arrays, unless they are one (the solver packs SoA input that way).
+template <class View>
+void pack(const View& from, const PackedView<typename RecordOf<View>::type>& to) {
+  using Record = typename RecordOf<View>::type;
+  using T = typename PackedValue<Record>::type;
+  check_counts(from.count, to.count, "collide::pack");
+  for_bodies(from.count, [&](std::size_t i) {
+    Record& r = to.bodies[i];
+    for_each_body_field<Record>([&](auto at) {
+      using At = decltype(at);
+      if constexpr (kKeptBeside<Record, At::field.member>) {
+        T* beside = beside_records(to);
+        if (beside != At::of(from)) beside[i] = At::of(from)[i];
+      } else {
+        At::of(r) = At::of(from)[i];
+      }
+    });
+  });
 }
 
-/// v (and w where the record has it) of the movable bodies, back into SoA.
-template <class Record, class View>
-void unpack_velocities_of(const PackedView<Record>& from, const View& to) {
+namespace {
+
+/// Every field of the model's table (collide/bodies.hpp) back, body by body;
+/// with kVelocitiesOnly, only v and w of the movable bodies. A rigid view's
+/// inverse masses, kept beside the records, come from the view's array.
+template <bool kVelocitiesOnly, class Record, class View>
+void unpack_fields(const PackedView<Record>& from, const View& to) {
   using T = typename PackedValue<Record>::type;
-  check_counts(from.count, to.count, "collide::unpack_velocities");
+  check_counts(from.count, to.count, kVelocitiesOnly ? "collide::unpack_velocities" : "collide::unpack");
   for_bodies(from.count, [&](std::size_t i) {
     const Record& r = from.bodies[i];
-    if (packed_inv_mass(from, i) == T(0)) return;
-    put3(to.v, r.v, i);
-    if constexpr (!std::is_same_v<Record, PackedParticle<T>>) put3(to.w, r.w, i);
+    if (kVelocitiesOnly && packed_inv_mass(from, i) == T(0)) return;
+    for_each_body_field<Record>([&](auto at) {
+      using At = decltype(at);
+      if constexpr (kVelocitiesOnly && At::field.role != ArrayRole::velocity) {
+        return;
+      } else if constexpr (kKeptBeside<Record, At::field.member>) {
+        At::of(to)[i] = beside_records(from)[i];
+      } else {
+        At::of(to)[i] = At::of(r);
+      }
+    });
   });
 }
 
 }  // namespace
 
-template <class U>
-void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_const_t<U>>>& to) {
-  check_counts(from.count, to.count, "collide::pack");
-  for_bodies(from.count, [&](std::size_t i) {
-    auto& r = to.bodies[i];
-    get3(r.v, from.v, i), get3(r.w, from.w, i), get3(r.p, from.p, i);
-    r.q[0] = from.q.w[i], r.q[1] = from.q.x[i], r.q[2] = from.q.y[i], r.q[3] = from.q.z[i];
-    // The solver packs SoA input with the caller's inverse masses as the
-    // view's own: nothing to copy then.
-    if (to.inv_mass != from.inv_mass) to.inv_mass[i] = from.inv_mass[i];
-    r.inv_inertia[0] = from.inv_inertia.x[i], r.inv_inertia[1] = from.inv_inertia.y[i];
-    r.inv_inertia[2] = from.inv_inertia.z[i];
-  });
+template <class Record>
+void unpack(const PackedView<Record>& from, const typename SoaViewOf<Record>::type& to) {
+  unpack_fields<false>(from, to);
 }
 
-template <class U>
-void pack(const SphereView<U>& from, const PackedView<PackedSphere<std::remove_const_t<U>>>& to) {
-  check_counts(from.count, to.count, "collide::pack");
-  for_bodies(from.count, [&](std::size_t i) {
-    auto& r = to.bodies[i];
-    get3(r.v, from.v, i), get3(r.w, from.w, i), get3(r.p, from.p, i);
-    r.inv_mass = from.inv_mass[i];
-    r.inv_inertia = from.inv_inertia[i];
-  });
+template <class Record>
+void unpack_velocities(const PackedView<Record>& from, const typename SoaViewOf<Record>::type& to) {
+  unpack_fields<true>(from, to);
 }
 
-template <class U>
-void pack(const ParticleView<U>& from, const PackedView<PackedParticle<std::remove_const_t<U>>>& to) {
-  check_counts(from.count, to.count, "collide::pack");
-  for_bodies(from.count, [&](std::size_t i) {
-    auto& r = to.bodies[i];
-    get3(r.v, from.v, i);
-    r.inv_mass = from.inv_mass[i];
-  });
-}
-
-template <class T>
-void unpack(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    put3(to.v, r.v, i), put3(to.w, r.w, i), put3(to.p, r.p, i);
-    to.q.w[i] = r.q[0], to.q.x[i] = r.q[1], to.q.y[i] = r.q[2], to.q.z[i] = r.q[3];
-    to.inv_mass[i] = from.inv_mass[i];
-    to.inv_inertia.x[i] = r.inv_inertia[0], to.inv_inertia.y[i] = r.inv_inertia[1];
-    to.inv_inertia.z[i] = r.inv_inertia[2];
-  });
-}
-
-template <class T>
-void unpack(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    put3(to.v, r.v, i), put3(to.w, r.w, i), put3(to.p, r.p, i);
-    to.inv_mass[i] = r.inv_mass;
-    to.inv_inertia[i] = r.inv_inertia;
-  });
-}
-
-template <class T>
-void unpack(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to) {
-  check_counts(from.count, to.count, "collide::unpack");
-  for_bodies(from.count, [&](std::size_t i) {
-    const auto& r = from.bodies[i];
-    put3(to.v, r.v, i);
-    to.inv_mass[i] = r.inv_mass;
-  });
-}
-
-template <class T>
-void unpack_velocities(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to) {
-  unpack_velocities_of(from, to);
-}
-
-template <class T>
-void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to) {
-  unpack_velocities_of(from, to);
-}
-
-template <class T>
-void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to) {
-  unpack_velocities_of(from, to);
-}
-
-template void pack<float>(const BodyView<float>&, const PackedView<PackedRigid<float>>&);
-template void pack<float>(const SphereView<float>&, const PackedView<PackedSphere<float>>&);
-template void pack<float>(const ParticleView<float>&, const PackedView<PackedParticle<float>>&);
-template void pack<const float>(const BodyView<const float>&, const PackedView<PackedRigid<float>>&);
-template void pack<const float>(const SphereView<const float>&, const PackedView<PackedSphere<float>>&);
-template void pack<const float>(const ParticleView<const float>&, const PackedView<PackedParticle<float>>&);
-template void pack<double>(const BodyView<double>&, const PackedView<PackedRigid<double>>&);
-template void pack<double>(const SphereView<double>&, const PackedView<PackedSphere<double>>&);
-template void pack<double>(const ParticleView<double>&, const PackedView<PackedParticle<double>>&);
-template void pack<const double>(const BodyView<const double>&, const PackedView<PackedRigid<double>>&);
-template void pack<const double>(const SphereView<const double>&, const PackedView<PackedSphere<double>>&);
-template void pack<const double>(const ParticleView<const double>&, const PackedView<PackedParticle<double>>&);
-template void unpack<float>(const PackedView<PackedRigid<float>>&, const BodyView<float>&);
-template void unpack<float>(const PackedView<PackedSphere<float>>&, const SphereView<float>&);
-template void unpack<float>(const PackedView<PackedParticle<float>>&, const ParticleView<float>&);
-template void unpack_velocities<float>(const PackedView<PackedRigid<float>>&, const BodyView<float>&);
-template void unpack_velocities<float>(const PackedView<PackedSphere<float>>&, const SphereView<float>&);
-template void unpack_velocities<float>(const PackedView<PackedParticle<float>>&, const ParticleView<float>&);
-template void unpack<double>(const PackedView<PackedRigid<double>>&, const BodyView<double>&);
-template void unpack<double>(const PackedView<PackedSphere<double>>&, const SphereView<double>&);
-template void unpack<double>(const PackedView<PackedParticle<double>>&, const ParticleView<double>&);
-template void unpack_velocities<double>(const PackedView<PackedRigid<double>>&, const BodyView<double>&);
-template void unpack_velocities<double>(const PackedView<PackedSphere<double>>&, const SphereView<double>&);
-template void unpack_velocities<double>(const PackedView<PackedParticle<double>>&, const ParticleView<double>&);
+// The conversions of every model, for T and const T input (T is a type:
+// no parentheses).
+// NOLINTBEGIN(bugprone-macro-parentheses)
+#define COLLIDE_INSTANTIATE(T)                                                                                   \
+  template void pack<BodyView<T>>(const BodyView<T>&, const PackedView<PackedRigid<T>>&);                        \
+  template void pack<BodyView<const T>>(const BodyView<const T>&, const PackedView<PackedRigid<T>>&);            \
+  template void unpack<PackedRigid<T>>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);                   \
+  template void unpack_velocities<PackedRigid<T>>(const PackedView<PackedRigid<T>>&, const BodyView<T>&);        \
+  template void pack<SphereView<T>>(const SphereView<T>&, const PackedView<PackedSphere<T>>&);                   \
+  template void pack<SphereView<const T>>(const SphereView<const T>&, const PackedView<PackedSphere<T>>&);       \
+  template void unpack<PackedSphere<T>>(const PackedView<PackedSphere<T>>&, const SphereView<T>&);               \
+  template void unpack_velocities<PackedSphere<T>>(const PackedView<PackedSphere<T>>&, const SphereView<T>&);    \
+  template void pack<ParticleView<T>>(const ParticleView<T>&, const PackedView<PackedParticle<T>>&);             \
+  template void pack<ParticleView<const T>>(const ParticleView<const T>&, const PackedView<PackedParticle<T>>&); \
+  template void unpack<PackedParticle<T>>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);         \
+  template void unpack_velocities<PackedParticle<T>>(const PackedView<PackedParticle<T>>&, const ParticleView<T>&);
+COLLIDE_INSTANTIATE(float)
+COLLIDE_INSTANTIATE(double)
+#undef COLLIDE_INSTANTIATE
+// NOLINTEND(bugprone-macro-parentheses)
 
 }  // namespace collide

@@ -23,56 +23,48 @@ template <class Record>
 inline constexpr std::size_t kStride = sizeof(Record) / sizeof(typename PackedValue<Record>::type);
 
 /// The W bodies idx[0..W) of a packed layout, read into lanes row by row
-/// (transpose_lanes.hpp). The value order is the record's (collide/packed.hpp).
+/// (transpose_lanes.hpp): the record's values in its own order, each put in
+/// the lane of its field (the model's table, collide/bodies.hpp); a rigid
+/// body's inverse mass, kept beside the records, by lanes from the view's
+/// dense array.
 template <class M, class V, class Record, class Index>
 COLLIDE_LANE_INLINE void read_records(const PackedView<Record>& view, const Index* idx, BodyLanes<M, V>& body) {
   using T = typename V::value_type;
-  constexpr std::size_t S = kStride<Record>;
+  constexpr std::size_t N = kRecordValues<Record>;
   const T* base = reinterpret_cast<const T*>(view.bodies);
-  if constexpr (std::is_same_v<Record, PackedRigid<T>>) {
-    static_assert(offsetof(PackedRigid<T>, inv_inertia) == 13 * sizeof(T) && S == 16, "value order of PackedRigid");
-    V x[16];
-    load_record_values<V, 16, S>(base, idx, x);
-    body.v = {x[0], x[1], x[2]};
-    body.w = {x[3], x[4], x[5]};
-    body.p = {x[6], x[7], x[8]};
-    body.q = {x[9], x[10], x[11], x[12]};
+  V x[N];
+  load_record_values<V, N, kStride<Record>>(base, idx, x);
+  for_each_lane_field<Record>([&](auto at) COLLIDE_LANE_LAMBDA {
+    using At = decltype(at);
+    if constexpr (!kKeptBeside<Record, At::field.member>) {
+      static_assert(record_slot<Record, At>() < N);
+      At::of(body) = x[record_slot<Record, At>()];
+    }
+  });
+  if constexpr (std::is_same_v<M, RigidModel>) {
     body.rotation = normalised_rotation(body.q);
-    body.inv_inertia = {x[13], x[14], x[15]};
+    // The one field kept beside the records (kKeptBeside), after their rows.
     body.inv_mass = gather<V>(static_cast<const T*>(view.inv_mass), idx);
-  } else if constexpr (std::is_same_v<Record, PackedSphere<T>>) {
-    static_assert(offsetof(PackedSphere<T>, inv_inertia) == 10 * sizeof(T), "value order of PackedSphere");
-    V x[11];
-    load_record_values<V, 11, S>(base, idx, x);
-    body.v = {x[0], x[1], x[2]};
-    body.w = {x[3], x[4], x[5]};
-    body.p = {x[6], x[7], x[8]};
-    body.inv_mass = x[9];
-    body.inv_inertia.x = x[10];
-  } else {
-    static_assert(offsetof(PackedParticle<T>, inv_mass) == 3 * sizeof(T), "value order of PackedParticle");
-    V x[4];
-    load_record_values<V, 4, S>(base, idx, x);
-    body.v = {x[0], x[1], x[2]};
-    body.inv_mass = x[3];
   }
 }
 
 /// Writes v (and w) of the lanes in `write` back into their records: the
-/// values the kernel changes, the first of each record.
+/// values the kernel changes (ArrayRole::velocity), the first of each record.
 template <class M, class V, class Record, class Index>
 COLLIDE_LANE_INLINE void write_records(const PackedView<Record>& view, const Index* idx, const BodyLanes<M, V>& body,
                                        const typename V::mask_type& write) {
   using T = typename V::value_type;
-  constexpr std::size_t S = kStride<Record>;
+  constexpr std::size_t N = kRotates<M> ? 6 : 3;
   T* base = reinterpret_cast<T*>(view.bodies);
-  if constexpr (kRotates<M>) {
-    const V x[6] = {body.v.x, body.v.y, body.v.z, body.w.x, body.w.y, body.w.z};
-    store_record_values<V, 6, S>(base, idx, x, write);
-  } else {
-    const V x[3] = {body.v.x, body.v.y, body.v.z};
-    store_record_values<V, 3, S>(base, idx, x, write);
-  }
+  V x[N];
+  for_each_lane_field<Record>([&](auto at) COLLIDE_LANE_LAMBDA {
+    using At = decltype(at);
+    if constexpr (At::field.role == ArrayRole::velocity) {
+      static_assert(record_slot<Record, At>() < N, "the velocities lead the record");
+      x[record_slot<Record, At>()] = At::of(body);
+    }
+  });
+  store_record_values<V, N, kStride<Record>>(base, idx, x, write);
 }
 
 /// Asks for the cache lines of body i's record (and of a rigid body's

@@ -181,8 +181,8 @@ class Walk {
         kernels_.range(job, consecutive(k), begin, stop);
       } else if (!plan_.simd) {
         kernels_.one_lane(job, false, begin, stop);
-      } else if (threads_ > 1 && !job.packed && !job.accurate && !job.friction && !job.stepped && !job.accumulates() &&
-                 stop - begin >= kPipelinedRunPieces * kRunPiece) {
+      } else if (threads_ > 1 && !job.packed() && !job.accurate && !job.friction && !job.stepped &&
+                 !job.accumulates() && stop - begin >= kPipelinedRunPieces * kRunPiece) {
         run_pipelined(job, begin, stop);
       } else {
         kernels_.run(job, begin, stop);

@@ -32,6 +32,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <type_traits>
 
 #include <oneapi/tbb/task_arena.h>
@@ -59,67 +60,20 @@ struct Solver::Impl {
   // to the largest scene and kept; the mutex makes packing solves on one
   // Solver take turns.
   std::mutex pack_mutex;
-  detail::ScratchRecords<PackedRigid<float>> rigid_f;
-  detail::ScratchRecords<PackedRigid<double>> rigid_d;
-  detail::ScratchRecords<PackedSphere<float>> sphere_f;
-  detail::ScratchRecords<PackedSphere<double>> sphere_d;
-  detail::ScratchRecords<PackedParticle<float>> particle_f;
-  detail::ScratchRecords<PackedParticle<double>> particle_d;
+  std::tuple<detail::ScratchRecords<PackedRigid<float>>, detail::ScratchRecords<PackedRigid<double>>,
+             detail::ScratchRecords<PackedSphere<float>>, detail::ScratchRecords<PackedSphere<double>>,
+             detail::ScratchRecords<PackedParticle<float>>, detail::ScratchRecords<PackedParticle<double>>>
+      records;
 
   // Where a colour-order solve copies its contacts (prepared_contacts.hpp);
   // such solves on one Solver take turns.
   std::mutex prepare_mutex;
-  detail::PreparedContacts<float> prepared_f;
-  detail::PreparedContacts<double> prepared_d;
+  std::tuple<detail::PreparedContacts<float>, detail::PreparedContacts<double>> prepared;
 
   // What a solve of several passes keeps between them (the accumulated
   // totals, J before the last pass); such solves on one Solver take turns.
   std::mutex iteration_mutex;
-  detail::IterationScratch<float> iteration_f;
-  detail::IterationScratch<double> iteration_d;
-
-  template <class T>
-  detail::IterationScratch<T>& iteration() {
-    if constexpr (std::is_same_v<T, float>) {
-      return iteration_f;
-    } else {
-      return iteration_d;
-    }
-  }
-
-  template <class T>
-  detail::PreparedContacts<T>& prepared() {
-    if constexpr (std::is_same_v<T, float>) {
-      return prepared_f;
-    } else {
-      return prepared_d;
-    }
-  }
-
-  template <class Record>
-  detail::ScratchRecords<Record>& buffer() {
-    using T = typename PackedValue<Record>::type;
-    constexpr bool f = std::is_same_v<T, float>;
-    if constexpr (std::is_same_v<Record, PackedRigid<T>>) {
-      if constexpr (f) {
-        return rigid_f;
-      } else {
-        return rigid_d;
-      }
-    } else if constexpr (std::is_same_v<Record, PackedSphere<T>>) {
-      if constexpr (f) {
-        return sphere_f;
-      } else {
-        return sphere_d;
-      }
-    } else {
-      if constexpr (f) {
-        return particle_f;
-      } else {
-        return particle_d;
-      }
-    }
-  }
+  std::tuple<detail::IterationScratch<float>, detail::IterationScratch<double>> iteration;
 
   explicit Impl(const SolverOptions& o)
       // int{...}: a prvalue copy, so that the static constant
@@ -207,20 +161,21 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   const bool warm = options.warm_start;
   const bool measures = plan.passes > 1 || warm;
   const bool prepares = detail::prepares_contacts(schedule);
+  detail::IterationScratch<T>& scratch = std::get<detail::IterationScratch<T>>(iteration);
   std::unique_lock<std::mutex> iteration_lock(iteration_mutex, std::defer_lock);
   detail::KernelJob<T> iterated = job;
   if (accumulates || measures) {
     iteration_lock.lock();
     const auto t_allocate = Clock::now();
-    if (iteration<T>().allocate(*arena, job.contacts.count, accumulates, job.friction, measures)) {
+    if (scratch.allocate(*arena, job.contacts.count, accumulates, job.friction, measures)) {
       allocate_seconds += seconds_since(t_allocate);
     }
-    if (accumulates) iterated.accumulated = iteration<T>().totals(job.friction);
+    if (accumulates) iterated.accumulated = scratch.totals(job.friction);
     // The totals are indexed as the walked J is: by prepared position when
     // the contacts are prepared in the schedule's order.
     if (warm) {
-      iteration<T>().warm(*arena, job.contacts, job.impulses, prepares ? schedule.solve_order() : nullptr, job.friction,
-                          measures);
+      scratch.warm(*arena, job.contacts, job.impulses, prepares ? schedule.solve_order() : nullptr, job.friction,
+                   measures);
     }
   }
   double residual = 1;
@@ -252,13 +207,13 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
         residual = std::numeric_limits<double>::quiet_NaN();
         return done;
       }
-      iteration<T>().save(*arena, on.impulses);
+      scratch.save(*arena, on.impulses);
     }
     detail::WalkPlan last = rest;
     last.passes = 1;
     last.continues = rest.continues || before.passes > 0;
     detail::walk_schedule(table, last, *arena, on, schedule);
-    residual = iteration<T>().residual(*arena, on.impulses);
+    residual = scratch.residual(*arena, on.impulses);
     return plan.passes;
   };
   std::size_t passes = 0;
@@ -268,7 +223,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
     // passes of the fast frictionless law, the velocity-free half is formed
     // with the copy and every pass takes the velocity step alone.
     const std::lock_guard<std::mutex> lock(prepare_mutex);
-    detail::PreparedContacts<T>& prepared_contacts = prepared<T>();
+    detail::PreparedContacts<T>& prepared_contacts = std::get<detail::PreparedContacts<T>>(prepared);
     const bool stepped = detail::steps_prepared_contacts(plan.passes, job.accurate, job.friction);
     const auto t_allocate = Clock::now();
     if (prepared_contacts.allocate(*arena, job, stepped)) allocate_seconds += seconds_since(t_allocate);
@@ -288,7 +243,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.conflicts = schedule.conflicts();
   stats.lanes = plan.width;
   stats.threads = arena->max_concurrency();
-  stats.model = job.model;
+  stats.model = job.model();
   stats.path = options.path;
   stats.friction = job.friction;
   // The scalar path is the one-lane loops, compiled for the baseline, on every ISA.
@@ -296,7 +251,7 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
   stats.isa_choice = pick.choice;
   stats.isa_calibration_seconds = pick.calibration_seconds;
   stats.allocate_seconds = allocate_seconds;
-  stats.layout = job.packed ? BodyLayout::packed : BodyLayout::soa;
+  stats.layout = job.packed() ? BodyLayout::packed : BodyLayout::soa;
   stats.accuracy = options.accuracy;
   stats.order = schedule.order();
   stats.colours = schedule.colours();
@@ -311,45 +266,20 @@ SolveStats Solver::Impl::run(const detail::IsaPick& pick, const detail::KernelJo
 namespace detail {
 namespace {
 
-template <class T>
-KernelJob<T> make_job(Model model, Accuracy accuracy, const ContactView<T>& contacts, const ImpulseView<T>& impulses,
-                      const Schedule& schedule) {
+/// The job of a solve of `bodies`, SoA or packed (the view's type names its
+/// model and layout: JobBodies); the solver may swap SoA bodies for the
+/// records it packs them into.
+template <class T, class View>
+KernelJob<T> make_job(const View& bodies, Accuracy accuracy, const ContactView<T>& contacts,
+                      const ImpulseView<T>& impulses, const Schedule& schedule) {
   KernelJob<T> job;
-  job.model = model;
+  job.bodies = bodies;
   job.accurate = accuracy == Accuracy::accurate;
   job.friction = contacts.mu != nullptr;
   job.contacts = contacts;
   job.impulses = impulses;
   job.order = schedule.solve_order();
   return job;
-}
-
-template <class T>
-void set_view(KernelJob<T>& job, const BodyView<T>& v) {
-  job.rigid = v;
-}
-template <class T>
-void set_view(KernelJob<T>& job, const SphereView<T>& v) {
-  job.sphere = v;
-}
-template <class T>
-void set_view(KernelJob<T>& job, const ParticleView<T>& v) {
-  job.particle = v;
-}
-template <class T>
-void set_view(KernelJob<T>& job, const PackedView<PackedRigid<T>>& v) {
-  job.packed = true;
-  job.packed_rigid = v;
-}
-template <class T>
-void set_view(KernelJob<T>& job, const PackedView<PackedSphere<T>>& v) {
-  job.packed = true;
-  job.packed_sphere = v;
-}
-template <class T>
-void set_view(KernelJob<T>& job, const PackedView<PackedParticle<T>>& v) {
-  job.packed = true;
-  job.packed_particle = v;
 }
 
 /// The name of the first null array of a SoA view (for_each_array), or nullptr.
@@ -432,12 +362,11 @@ template <class Record, class View, class T>
 SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<T>& contacts,
                              const ImpulseView<T>& impulses, const Schedule& schedule) const {
   detail::check_solve_input(model, bodies, contacts, impulses, schedule);
-  detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
+  detail::KernelJob<T> job = detail::make_job(bodies, impl_->options.accuracy, contacts, impulses, schedule);
   const std::size_t scattered = detail::scattered_contacts(schedule, contacts.a, contacts.b);
   const detail::IsaPick pick = detail::pick_isa<T>(impl_->options.path, impl_->options.accuracy, impl_->isa_choice,
                                                    impl_->kernels, model, scattered, schedule.contact_count());
   if (!detail::should_pack(impl_->options.layout, scattered, bodies.count)) {
-    detail::set_view(job, bodies);
     return impl_->run(pick, job, schedule, 0.0);
   }
   const std::lock_guard<std::mutex> lock(impl_->pack_mutex);
@@ -447,7 +376,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   {
     const auto t_allocate = Clock::now();
     detail::FirstTouch touch;
-    packed.bodies = impl_->buffer<Record>().reserve(bodies.count, touch);
+    packed.bodies = std::get<detail::ScratchRecords<Record>>(impl_->records).reserve(bodies.count, touch);
     if (!touch.empty()) {
       touch.run(*impl_->arena);
       allocate_seconds = seconds_since(t_allocate);
@@ -457,7 +386,7 @@ SolveStats Solver::solve_soa(Model model, const View& bodies, const ContactView<
   // only read them, so they are not copied.
   if constexpr (std::is_same_v<Record, PackedRigid<T>>) packed.inv_mass = bodies.inv_mass;
   impl_->arena->execute([&] { pack(bodies, packed); });
-  detail::set_view(job, packed);
+  job.bodies = packed;
   SolveStats stats = impl_->run(pick, job, schedule, allocate_seconds);
   impl_->arena->execute([&] { unpack_velocities(packed, bodies); });
   return stats;
@@ -467,8 +396,7 @@ template <class Record, class T>
 SolveStats Solver::solve_packed(Model model, const PackedView<Record>& bodies, const ContactView<T>& contacts,
                                 const ImpulseView<T>& impulses, const Schedule& schedule) const {
   detail::check_solve_input(model, bodies, contacts, impulses, schedule);
-  detail::KernelJob<T> job = detail::make_job(model, impl_->options.accuracy, contacts, impulses, schedule);
-  detail::set_view(job, bodies);
+  detail::KernelJob<T> job = detail::make_job(bodies, impl_->options.accuracy, contacts, impulses, schedule);
   const detail::IsaPick pick =
       detail::pick_isa<T>(impl_->options.path, impl_->options.accuracy, impl_->isa_choice, impl_->kernels, model,
                           detail::scattered_contacts(schedule, contacts.a, contacts.b), schedule.contact_count());

@@ -65,9 +65,10 @@ Validation fail(const char* view, const char* field, std::size_t i, T value, con
 
 Validation fail_text(const std::string& text) { return {false, text}; }
 
-/// The arrays of a body view, each with the rule it must obey.
+/// One array of a body view (or one field of its packed records), with the
+/// rule it must obey.
 template <class T>
-struct BodyField {
+struct CheckedArray {
   const char* name;
   const T* data;
   bool inverse;            // an inverse mass or moment: finite and >= 0; otherwise finite
@@ -77,72 +78,35 @@ struct BodyField {
 
 /// The arrays of a SoA view (for_each_array), with their rules.
 template <class View, class T = std::remove_const_t<std::remove_pointer_t<decltype(View::inv_mass)>>>
-std::vector<BodyField<T>> fields_of(const View& b) {
-  std::vector<BodyField<T>> fields;
+std::vector<CheckedArray<T>> fields_of(const View& b) {
+  std::vector<CheckedArray<T>> fields;
   for_each_array(b, [&](const char* name, const T* data, ArrayRole role) {
     fields.push_back({name, data, role == ArrayRole::inverse});
   });
   return fields;
 }
 
-/// The fields of packed records, in the order of the SoA views' (so the
-/// messages name the same fields); one null field when the records are null.
-template <class Record>
-struct PackedFields {
-  using T = typename PackedValue<Record>::type;
-  static constexpr std::size_t kStride = sizeof(Record) / sizeof(T);
-  BodyField<T> operator()(const char* name, const T* data, bool inverse) const {
-    return {name, data, inverse, kStride};
+/// The fields of packed records, in table order (so the messages name the
+/// same fields as the SoA views'); one null field when the records, or a
+/// rigid view's inverse masses, are null.
+template <class Record, class T = typename PackedValue<Record>::type>
+std::vector<CheckedArray<T>> fields_of(const PackedView<Record>& b) {
+  constexpr bool kRigid = std::is_same_v<Record, PackedRigid<T>>;
+  if (b.bodies == nullptr) return {{"records", nullptr, false, 1}};
+  if constexpr (kRigid) {
+    if (b.inv_mass == nullptr) return {{"inv_mass", nullptr, true, 1}};
   }
-};
-template <class T>
-std::vector<BodyField<T>> null_records() {
-  return {{"records", nullptr, false, 1}};
-}
-template <class T>
-std::vector<BodyField<T>> fields_of(const PackedView<PackedRigid<T>>& b) {
-  const PackedFields<PackedRigid<T>> f;
-  const PackedRigid<T>* r = b.bodies;
-  if (r == nullptr) return null_records<T>();
-  if (b.inv_mass == nullptr) return {{"inv_mass", nullptr, true, 1}};
-  // The inverse masses are the view's own array (collide/packed.hpp).
-  return {{"inv_mass", b.inv_mass, true, 1},
-          f("inv_inertia.x", &r->inv_inertia[0], true),
-          f("inv_inertia.y", &r->inv_inertia[1], true),
-          f("inv_inertia.z", &r->inv_inertia[2], true),
-          f("q.w", &r->q[0], false),
-          f("q.x", &r->q[1], false),
-          f("q.y", &r->q[2], false),
-          f("q.z", &r->q[3], false),
-          f("p.x", &r->p[0], false),
-          f("p.y", &r->p[1], false),
-          f("p.z", &r->p[2], false),
-          f("v.x", &r->v[0], false),
-          f("v.y", &r->v[1], false),
-          f("v.z", &r->v[2], false),
-          f("w.x", &r->w[0], false),
-          f("w.y", &r->w[1], false),
-          f("w.z", &r->w[2], false)};
-}
-template <class T>
-std::vector<BodyField<T>> fields_of(const PackedView<PackedSphere<T>>& b) {
-  const PackedFields<PackedSphere<T>> f;
-  const PackedSphere<T>* r = b.bodies;
-  if (r == nullptr) return null_records<T>();
-  return {f("inv_mass", &r->inv_mass, true), f("inv_inertia", &r->inv_inertia, true),
-          f("p.x", &r->p[0], false),         f("p.y", &r->p[1], false),
-          f("p.z", &r->p[2], false),         f("v.x", &r->v[0], false),
-          f("v.y", &r->v[1], false),         f("v.z", &r->v[2], false),
-          f("w.x", &r->w[0], false),         f("w.y", &r->w[1], false),
-          f("w.z", &r->w[2], false)};
-}
-template <class T>
-std::vector<BodyField<T>> fields_of(const PackedView<PackedParticle<T>>& b) {
-  const PackedFields<PackedParticle<T>> f;
-  const PackedParticle<T>* r = b.bodies;
-  if (r == nullptr) return null_records<T>();
-  return {f("inv_mass", &r->inv_mass, true), f("v.x", &r->v[0], false), f("v.y", &r->v[1], false),
-          f("v.z", &r->v[2], false)};
+  std::vector<CheckedArray<T>> fields;
+  for_each_body_field<Record>([&](auto at) {
+    using At = decltype(at);
+    const bool inverse = At::field.role == ArrayRole::inverse;
+    if constexpr (kKeptBeside<Record, At::field.member>) {
+      fields.push_back({At::field.name, beside_records(b), inverse, 1});
+    } else {
+      fields.push_back({At::field.name, &At::of(b.bodies[0]), inverse, sizeof(Record) / sizeof(T)});
+    }
+  });
+  return fields;
 }
 
 /// The quaternion of the rigid model, under the scene files' rule
@@ -315,22 +279,22 @@ bool screen_indices(const BodyIndex* a, const BodyIndex* b, std::size_t count, s
 /// The body rules of validate_any's scan, screened over bodies [i0, i1) of
 /// SoA views: one screen per array, and |q| for the rigid model.
 template <class T>
-bool screen_soa(const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
-  for (const BodyField<T>& f : fields) {
+bool screen_soa(const std::vector<CheckedArray<T>>& fields, std::size_t i0, std::size_t i1) {
+  for (const CheckedArray<T>& f : fields) {
     if (!screen_values(f.data + i0, i1 - i0, f.inverse)) return false;
   }
   return true;
 }
 template <class T>
-bool screen_bodies(const BodyView<T>& b, const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
+bool screen_bodies(const BodyView<T>& b, const std::vector<CheckedArray<T>>& fields, std::size_t i0, std::size_t i1) {
   return screen_soa(fields, i0, i1) && screen_quaternion<T>({b.q.w + i0, b.q.x + i0, b.q.y + i0, b.q.z + i0}, i1 - i0);
 }
 template <class T>
-bool screen_bodies(const SphereView<T>&, const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
+bool screen_bodies(const SphereView<T>&, const std::vector<CheckedArray<T>>& fields, std::size_t i0, std::size_t i1) {
   return screen_soa(fields, i0, i1);
 }
 template <class T>
-bool screen_bodies(const ParticleView<T>&, const std::vector<BodyField<T>>& fields, std::size_t i0, std::size_t i1) {
+bool screen_bodies(const ParticleView<T>&, const std::vector<CheckedArray<T>>& fields, std::size_t i0, std::size_t i1) {
   return screen_soa(fields, i0, i1);
 }
 
@@ -342,7 +306,7 @@ bool screen_bodies(const ParticleView<T>&, const std::vector<BodyField<T>>& fiel
 /// record should this file be built for wider ones.
 template <class Record>
 bool screen_records(const PackedView<Record>& b,
-                    const std::vector<BodyField<typename PackedValue<Record>::type>>& fields, std::size_t i0,
+                    const std::vector<CheckedArray<typename PackedValue<Record>::type>>& fields, std::size_t i0,
                     std::size_t i1) {
   using T = typename PackedValue<Record>::type;
   using S = Screen<T>;
@@ -358,7 +322,7 @@ bool screen_records(const PackedView<Record>& b,
   used.fill(I(0));
   inverse.fill(I(0));
   const T* base = &b.bodies[0].v[0];
-  for (const BodyField<T>& f : fields) {
+  for (const CheckedArray<T>& f : fields) {
     if (f.stride != kValues) continue;  // not in the record (a rigid view's inv_mass)
     const auto at = static_cast<std::size_t>(f.data - base);
     used[at / kLanes][at % kLanes] = -1;
@@ -376,7 +340,7 @@ bool screen_records(const PackedView<Record>& b,
   return bits_ok(finite_bits, sign);
 }
 template <class T>
-bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<BodyField<T>>& fields, std::size_t i0,
+bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<CheckedArray<T>>& fields, std::size_t i0,
                    std::size_t i1) {
   if (!screen_records(b, fields, i0, i1)) return false;
   if (!screen_values(b.inv_mass + i0, i1 - i0, true)) return false;
@@ -388,12 +352,12 @@ bool screen_bodies(const PackedView<PackedRigid<T>>& b, const std::vector<BodyFi
   return bad == 0;
 }
 template <class T>
-bool screen_bodies(const PackedView<PackedSphere<T>>& b, const std::vector<BodyField<T>>& fields, std::size_t i0,
+bool screen_bodies(const PackedView<PackedSphere<T>>& b, const std::vector<CheckedArray<T>>& fields, std::size_t i0,
                    std::size_t i1) {
   return screen_records(b, fields, i0, i1);
 }
 template <class T>
-bool screen_bodies(const PackedView<PackedParticle<T>>& b, const std::vector<BodyField<T>>& fields, std::size_t i0,
+bool screen_bodies(const PackedView<PackedParticle<T>>& b, const std::vector<CheckedArray<T>>& fields, std::size_t i0,
                    std::size_t i1) {
   return screen_records(b, fields, i0, i1);
 }
@@ -497,9 +461,9 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
     return fail_text("impulses.count = " + std::to_string(impulses.count) +
                      " but contacts.count = " + std::to_string(contacts.count));
   }
-  const std::vector<BodyField<T>> fields = fields_of(bodies);
+  const std::vector<CheckedArray<T>> fields = fields_of(bodies);
   if (bodies.count > 0) {
-    for (const BodyField<T>& f : fields) {
+    for (const CheckedArray<T>& f : fields) {
       if (f.data == nullptr) {
         return fail_text(std::string("bodies.") + f.name +
                          " is null but bodies.count = " + std::to_string(bodies.count));
@@ -530,7 +494,7 @@ Validation validate_any(const View& bodies, const ContactView<T>& contacts, cons
   }
 
   for (std::size_t i = 0; i < bodies.count; ++i) {
-    for (const BodyField<T>& f : fields) {
+    for (const CheckedArray<T>& f : fields) {
       const T x = f[i];
       if (f.inverse && (!std::isfinite(x) || x < T(0))) return fail("bodies", f.name, i, x, "must be finite and >= 0");
       if (!f.inverse && !std::isfinite(x)) return fail("bodies", f.name, i, x, "must be finite");

@@ -13,19 +13,144 @@
 //   its view drops mu (frictionless) exactly when every mu is 0; record() and
 //   set() round-trip. A normal off unit by more than the files' tolerance is
 //   refused (every rule is test_rules.cpp's).
+// * Each model's field table (kRigidFields, kSphereFields, kParticleFields)
+//   names every array of its view once, in member order, with its role:
+//   for_each_array, which the checks walk, reaches exactly the member a
+//   view sets by hand; the packed records' fields land on their values
+//   (record_slot against offsetof, test_packed.cpp's layout).
 // The precision conversion of scenes is io's (tests/io/test_scene_convert.cpp).
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "collide/bodies.hpp"
 #include "collide/contacts.hpp"
+#include "collide/packed.hpp"
 
 namespace collide::test {
 namespace {
+
+/// What for_each_array reported of one array.
+struct Visited {
+  std::string name;
+  const float* array;
+  ArrayRole role;
+};
+
+template <class View>
+std::vector<Visited> visit(const View& view) {
+  std::vector<Visited> out;
+  for_each_array(view, [&](const char* name, const float* array, ArrayRole role) {
+    out.push_back({name, array, role});
+  });
+  return out;
+}
+
+/// Expects the walk to give exactly these arrays, in this order.
+void expect_walk(const std::vector<Visited>& walked, const std::vector<Visited>& expected) {
+  ASSERT_EQ(walked.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    SCOPED_TRACE(expected[k].name);
+    EXPECT_EQ(walked[k].name, expected[k].name);
+    EXPECT_EQ(walked[k].array, expected[k].array);
+    EXPECT_EQ(walked[k].role, expected[k].role);
+  }
+}
+
+TEST(FieldTables, RigidTableNamesEveryMemberOfTheViewOnce) {
+  float storage[17] = {};
+  const float* s = storage;
+  // Every member set by hand, to its own array, in declaration order.
+  const BodyView<const float> b{1,
+                                s + 0,
+                                {s + 1, s + 2, s + 3},
+                                {s + 4, s + 5, s + 6, s + 7},
+                                {s + 8, s + 9, s + 10},
+                                {s + 11, s + 12, s + 13},
+                                {s + 14, s + 15, s + 16}};
+  const ArrayRole inv = ArrayRole::inverse, state = ArrayRole::state, vel = ArrayRole::velocity;
+  expect_walk(visit(b), {{"inv_mass", s + 0, inv},
+                         {"inv_inertia.x", s + 1, inv},
+                         {"inv_inertia.y", s + 2, inv},
+                         {"inv_inertia.z", s + 3, inv},
+                         {"q.w", s + 4, state},
+                         {"q.x", s + 5, state},
+                         {"q.y", s + 6, state},
+                         {"q.z", s + 7, state},
+                         {"p.x", s + 8, state},
+                         {"p.y", s + 9, state},
+                         {"p.z", s + 10, state},
+                         {"v.x", s + 11, vel},
+                         {"v.y", s + 12, vel},
+                         {"v.z", s + 13, vel},
+                         {"w.x", s + 14, vel},
+                         {"w.y", s + 15, vel},
+                         {"w.z", s + 16, vel}});
+  EXPECT_EQ(kFieldCount<BodyView<float>>, 17u);
+}
+
+TEST(FieldTables, SphereAndParticleTablesNameEveryMemberOfTheirViewsOnce) {
+  float storage[11] = {};
+  const float* s = storage;
+  const SphereView<const float> sphere{
+      1, s + 0, s + 1, {s + 2, s + 3, s + 4}, {s + 5, s + 6, s + 7}, {s + 8, s + 9, s + 10}};
+  const ArrayRole inv = ArrayRole::inverse, state = ArrayRole::state, vel = ArrayRole::velocity;
+  expect_walk(visit(sphere), {{"inv_mass", s + 0, inv},
+                              {"inv_inertia", s + 1, inv},
+                              {"p.x", s + 2, state},
+                              {"p.y", s + 3, state},
+                              {"p.z", s + 4, state},
+                              {"v.x", s + 5, vel},
+                              {"v.y", s + 6, vel},
+                              {"v.z", s + 7, vel},
+                              {"w.x", s + 8, vel},
+                              {"w.y", s + 9, vel},
+                              {"w.z", s + 10, vel}});
+  const ParticleView<const float> particle{1, s + 0, {s + 1, s + 2, s + 3}};
+  expect_walk(visit(particle),
+              {{"inv_mass", s + 0, inv}, {"v.x", s + 1, vel}, {"v.y", s + 2, vel}, {"v.z", s + 3, vel}});
+}
+
+/// Every field of Record's table but the one kept beside it sits at its
+/// record_slot among the record's values; the slots are distinct and fill
+/// the record's first kRecordValues values.
+template <class Record>
+void expect_record_slots() {
+  using T = typename PackedValue<Record>::type;
+  Record r{};
+  const T* first = reinterpret_cast<const T*>(&r);
+  std::vector<int> seen(kRecordValues<Record>, 0);
+  std::size_t beside = 0;
+  for_each_body_field<Record>([&](auto at) {
+    using At = decltype(at);
+    SCOPED_TRACE(At::field.name);
+    if constexpr (kKeptBeside<Record, At::field.member>) {
+      ++beside;
+    } else {
+      constexpr std::size_t slot = record_slot<Record, At>();
+      ASSERT_LT(slot, seen.size());
+      EXPECT_EQ(&At::of(r), first + slot);
+      ++seen[slot];
+    }
+  });
+  for (std::size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], 1) << "value " << k;
+  EXPECT_EQ(beside + kRecordValues<Record>, kFieldCount<Record>);
+}
+
+TEST(FieldTables, PackedFieldsLandOnTheirRecordValues) {
+  expect_record_slots<PackedRigid<float>>();
+  expect_record_slots<PackedRigid<double>>();
+  expect_record_slots<PackedSphere<float>>();
+  expect_record_slots<PackedSphere<double>>();
+  expect_record_slots<PackedParticle<float>>();
+  expect_record_slots<PackedParticle<double>>();
+}
 
 template <class T>
 class Buffers : public ::testing::Test {};

@@ -18,8 +18,11 @@
 // The header is C++17 so that C++17 programs can embed the kernel.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "collide/large_allocator.hpp"
@@ -105,49 +108,179 @@ enum class ArrayRole {
   velocity,  ///< a velocity component: read, and written for movable bodies; finite
 };
 
-/// Calls f(name, array, role) for every array of the view, in member order:
-/// the one list of a view's arrays that the checks at the solver's
-/// boundaries (validate(), Solver::solve) walk.
-template <class T, class F>
-void for_each_array(const BodyView<T>& b, F&& f) {
-  f("inv_mass", b.inv_mass, ArrayRole::inverse);
-  f("inv_inertia.x", b.inv_inertia.x, ArrayRole::inverse);
-  f("inv_inertia.y", b.inv_inertia.y, ArrayRole::inverse);
-  f("inv_inertia.z", b.inv_inertia.z, ArrayRole::inverse);
-  f("q.w", b.q.w, ArrayRole::state);
-  f("q.x", b.q.x, ArrayRole::state);
-  f("q.y", b.q.y, ArrayRole::state);
-  f("q.z", b.q.z, ArrayRole::state);
-  f("p.x", b.p.x, ArrayRole::state);
-  f("p.y", b.p.y, ArrayRole::state);
-  f("p.z", b.p.z, ArrayRole::state);
-  f("v.x", b.v.x, ArrayRole::velocity);
-  f("v.y", b.v.y, ArrayRole::velocity);
-  f("v.z", b.v.z, ArrayRole::velocity);
-  f("w.x", b.w.x, ArrayRole::velocity);
-  f("w.y", b.w.y, ArrayRole::velocity);
-  f("w.z", b.w.z, ArrayRole::velocity);
+/// The member of a body view an array belongs to. The kernel's lanes and the
+/// packed records (collide/packed.hpp) name their members the same way, so
+/// one field table serves them all (body_member).
+enum class BodyMember : std::uint8_t { inv_mass, inv_inertia, q, p, v, w };
+
+/// One member of a body model: where it lives, what the solver does with
+/// it, and the name the checks give each of its arrays (one for a scalar,
+/// three for a vector, four for the quaternion: w, x, y, z).
+struct BodyMemberRow {
+  BodyMember member;
+  ArrayRole role;
+  const char* names[4];
+  [[nodiscard]] constexpr std::size_t components() const {
+    std::size_t n = 0;
+    while (n < 4 && names[n] != nullptr) ++n;
+    return n;
+  }
+};
+
+/// The field table of each model: its members in member order, the one list
+/// of a model's arrays. Validation, the solver's boundary checks, packing,
+/// the owning buffers and the kernel's loads and stores all walk these
+/// tables (for_each_body_field).
+inline constexpr BodyMemberRow kRigidFields[] = {
+    {BodyMember::inv_mass, ArrayRole::inverse, {"inv_mass"}},
+    {BodyMember::inv_inertia, ArrayRole::inverse, {"inv_inertia.x", "inv_inertia.y", "inv_inertia.z"}},
+    {BodyMember::q, ArrayRole::state, {"q.w", "q.x", "q.y", "q.z"}},
+    {BodyMember::p, ArrayRole::state, {"p.x", "p.y", "p.z"}},
+    {BodyMember::v, ArrayRole::velocity, {"v.x", "v.y", "v.z"}},
+    {BodyMember::w, ArrayRole::velocity, {"w.x", "w.y", "w.z"}},
+};
+inline constexpr BodyMemberRow kSphereFields[] = {
+    {BodyMember::inv_mass, ArrayRole::inverse, {"inv_mass"}},
+    {BodyMember::inv_inertia, ArrayRole::inverse, {"inv_inertia"}},
+    {BodyMember::p, ArrayRole::state, {"p.x", "p.y", "p.z"}},
+    {BodyMember::v, ArrayRole::velocity, {"v.x", "v.y", "v.z"}},
+    {BodyMember::w, ArrayRole::velocity, {"w.x", "w.y", "w.z"}},
+};
+inline constexpr BodyMemberRow kParticleFields[] = {
+    {BodyMember::inv_mass, ArrayRole::inverse, {"inv_mass"}},
+    {BodyMember::v, ArrayRole::velocity, {"v.x", "v.y", "v.z"}},
+};
+
+/// One array of a body model: an element of one of its members.
+struct BodyField {
+  const char* name;
+  BodyMember member;
+  /// The element of a vector member: x, y, z = 0, 1, 2; of q: w, x, y, z =
+  /// 0, 1, 2, 3; 0 for a scalar member.
+  std::size_t component;
+  ArrayRole role;
+};
+
+/// The number of arrays of a field table.
+template <std::size_t N>
+constexpr std::size_t field_count(const BodyMemberRow (&rows)[N]) {
+  std::size_t n = 0;
+  for (const BodyMemberRow& row : rows) n += row.components();
+  return n;
 }
-template <class T, class F>
-void for_each_array(const SphereView<T>& b, F&& f) {
-  f("inv_mass", b.inv_mass, ArrayRole::inverse);
-  f("inv_inertia", b.inv_inertia, ArrayRole::inverse);
-  f("p.x", b.p.x, ArrayRole::state);
-  f("p.y", b.p.y, ArrayRole::state);
-  f("p.z", b.p.z, ArrayRole::state);
-  f("v.x", b.v.x, ArrayRole::velocity);
-  f("v.y", b.v.y, ArrayRole::velocity);
-  f("v.z", b.v.z, ArrayRole::velocity);
-  f("w.x", b.w.x, ArrayRole::velocity);
-  f("w.y", b.w.y, ArrayRole::velocity);
-  f("w.z", b.w.z, ArrayRole::velocity);
+
+/// Array K of a field table, counted over its members' elements in order.
+template <std::size_t N>
+constexpr BodyField field_at(const BodyMemberRow (&rows)[N], std::size_t k) {
+  for (const BodyMemberRow& row : rows) {
+    if (k < row.components()) return {row.names[k], row.member, k, row.role};
+    k -= row.components();
+  }
+  return {nullptr, BodyMember::inv_mass, 0, ArrayRole::inverse};  // not reached: k < field_count(rows)
 }
-template <class T, class F>
-void for_each_array(const ParticleView<T>& b, F&& f) {
-  f("inv_mass", b.inv_mass, ArrayRole::inverse);
-  f("v.x", b.v.x, ArrayRole::velocity);
-  f("v.y", b.v.y, ArrayRole::velocity);
-  f("v.z", b.v.z, ArrayRole::velocity);
+
+/// The field table of a model's view type (and, in collide/packed.hpp, of
+/// its packed record): `rows` is one of the tables above.
+template <class View>
+struct BodyFieldTable;
+template <class T>
+struct BodyFieldTable<BodyView<T>> {
+  static constexpr const auto& rows = kRigidFields;
+};
+template <class T>
+struct BodyFieldTable<SphereView<T>> {
+  static constexpr const auto& rows = kSphereFields;
+};
+template <class T>
+struct BodyFieldTable<ParticleView<T>> {
+  static constexpr const auto& rows = kParticleFields;
+};
+
+/// The number of arrays of Table's model.
+template <class Table>
+inline constexpr std::size_t kFieldCount = field_count(BodyFieldTable<Table>::rows);
+
+namespace body_fields_detail {
+template <class X, class = void>
+struct HasX : std::false_type {};
+template <class X>
+struct HasX<X, std::void_t<decltype(std::declval<X&>().x)>> : std::true_type {};
+
+// Element C of a member: of a C array by index, of a struct by x, y, z (a
+// quaternion by w, x, y, z), and a scalar member (or a pointer to its
+// array) is its own element 0.
+template <std::size_t C, bool kQuaternion, class X>
+constexpr auto& element(X& x) {
+  using U = std::remove_const_t<X>;
+  if constexpr (std::is_array_v<U>) {
+    return x[C];
+  } else if constexpr (kQuaternion) {
+    static_assert(C < 4);
+    if constexpr (C == 0) return x.w;
+    if constexpr (C == 1) return x.x;
+    if constexpr (C == 2) return x.y;
+    if constexpr (C == 3) return x.z;
+  } else if constexpr (HasX<U>::value) {
+    static_assert(C < 3);
+    if constexpr (C == 0) return x.x;
+    if constexpr (C == 1) return x.y;
+    if constexpr (C == 2) return x.z;
+  } else {
+    static_assert(C == 0);
+    return x;
+  }
+}
+}  // namespace body_fields_detail
+
+/// Member M, element C, of anything that names its members as the views do:
+/// a view (the array), the kernel's lanes (the lane), a packed record (the
+/// value).
+template <BodyMember M, std::size_t C, class S>
+constexpr auto& body_member(S& s) {
+  using body_fields_detail::element;
+  if constexpr (M == BodyMember::inv_mass) return element<C, false>(s.inv_mass);
+  if constexpr (M == BodyMember::inv_inertia) return element<C, false>(s.inv_inertia);
+  if constexpr (M == BodyMember::q) return element<C, true>(s.q);
+  if constexpr (M == BodyMember::p) return element<C, false>(s.p);
+  if constexpr (M == BodyMember::v) return element<C, false>(s.v);
+  if constexpr (M == BodyMember::w) return element<C, false>(s.w);
+}
+
+/// Array K of Table's model as a type, for code that walks the table at
+/// compile time: `field` is the entry, of(s) its member element in s.
+template <class Table, std::size_t K>
+struct BodyFieldAt {
+  static constexpr BodyField field = field_at(BodyFieldTable<Table>::rows, K);
+  static constexpr std::size_t index = K;
+  template <class S>
+  static constexpr auto& of(S& s) {
+    return body_member<field.member, field.component>(s);
+  }
+};
+
+namespace body_fields_detail {
+template <class Table, class F, std::size_t... K>
+constexpr void each_field(F& f, std::index_sequence<K...> /*fields*/) {
+  (f(BodyFieldAt<Table, K>{}), ...);
+}
+}  // namespace body_fields_detail
+
+/// Calls f(BodyFieldAt<Table, K>{}) for every array K of Table's model, in
+/// table order.
+template <class Table, class F>
+constexpr void for_each_body_field(F&& f) {
+  body_fields_detail::each_field<Table>(f, std::make_index_sequence<kFieldCount<Table>>{});
+}
+
+/// Calls f(name, array, role) for every array of the view, in table order:
+/// the walk the checks at the solver's boundaries (validate(),
+/// Solver::solve) make.
+template <class View, class F>
+void for_each_array(const View& b, F&& f) {
+  for_each_body_field<View>([&](auto at) {
+    using At = decltype(at);
+    f(At::field.name, At::of(b), At::field.role);
+  });
 }
 
 /// The sphere-model view of rigid bodies (uses inv_inertia.x as the one
@@ -196,7 +329,7 @@ class BodyBuffer {
 
   void resize(std::size_t n);
   void reserve(std::size_t n);
-  [[nodiscard]] std::size_t size() const { return inv_mass_.size(); }
+  [[nodiscard]] std::size_t size() const { return columns_[0].size(); }
 
   /// Appends a body given in physical units: stores 1/m and 1/I (0 for inf),
   /// zeroes the inverse moments of an immovable body and keeps q as given
@@ -217,8 +350,8 @@ class BodyBuffer {
 
  private:
   using Column = std::vector<T, LargeAllocator<T>>;
-  Column inv_mass_, ix_, iy_, iz_, qw_, qx_, qy_, qz_;
-  Column px_, py_, pz_, vx_, vy_, vz_, wx_, wy_, wz_;
+  /// One column per array of kRigidFields, in table order.
+  std::array<Column, field_count(kRigidFields)> columns_;
 };
 
 /// True for the inverse mass of an immovable body: 0, whatever the moments

@@ -177,37 +177,108 @@ T packed_inv_mass(const PackedView<PackedRigid<T>>& view, std::size_t i) {
   return view.inv_mass[i];
 }
 
+/// A packed record's fields: its model's table (collide/bodies.hpp), which
+/// names the record's members as it names the view's.
+template <class T>
+struct BodyFieldTable<PackedRigid<T>> : BodyFieldTable<BodyView<T>> {};
+template <class T>
+struct BodyFieldTable<PackedSphere<T>> : BodyFieldTable<SphereView<T>> {};
+template <class T>
+struct BodyFieldTable<PackedParticle<T>> : BodyFieldTable<ParticleView<T>> {};
+
+/// True for the member a record keeps beside itself, in its view: a rigid
+/// body's inverse mass (PackedView<PackedRigid<T>>::inv_mass).
+template <class Record, BodyMember M>
+inline constexpr bool kKeptBeside =
+    M == BodyMember::inv_mass&& std::is_same_v<Record, PackedRigid<typename PackedValue<Record>::type>>;
+
+/// The array kept beside the records (kKeptBeside): a rigid view's inverse
+/// masses; none (nullptr) for the other records, which keep every field.
+template <class T>
+T* beside_records(const PackedView<PackedRigid<T>>& view) {
+  return view.inv_mass;
+}
+template <class Record>
+typename PackedValue<Record>::type* beside_records(const PackedView<Record>& /*view*/) {
+  return nullptr;
+}
+
+/// The values a record holds, from its first: its model's fields but those
+/// kept beside it.
+template <class Record>
+inline constexpr std::size_t kRecordValues =
+    kFieldCount<Record> - (std::is_same_v<Record, PackedRigid<typename PackedValue<Record>::type>> ? 1 : 0);
+
+/// Where a record holds member M: the index, among its values, of the
+/// member's element 0.
+template <class Record, BodyMember M>
+constexpr std::size_t record_member_offset() {
+  using T = typename PackedValue<Record>::type;
+  static_assert(!kKeptBeside<Record, M>, "a member kept beside the record has no place in it");
+  if constexpr (M == BodyMember::inv_mass) return offsetof(Record, inv_mass) / sizeof(T);
+  if constexpr (M == BodyMember::inv_inertia) return offsetof(Record, inv_inertia) / sizeof(T);
+  if constexpr (M == BodyMember::q) return offsetof(Record, q) / sizeof(T);
+  if constexpr (M == BodyMember::p) return offsetof(Record, p) / sizeof(T);
+  if constexpr (M == BodyMember::v) return offsetof(Record, v) / sizeof(T);
+  if constexpr (M == BodyMember::w) return offsetof(Record, w) / sizeof(T);
+}
+
+/// The index, among a record's values, of the field At (a BodyFieldAt).
+template <class Record, class At>
+constexpr std::size_t record_slot() {
+  return record_member_offset<Record, At::field.member>() + At::field.component;
+}
+
 // Conversions. Exact copies in both directions; `to.count` must equal
 // `from.count` (std::invalid_argument otherwise). Independent bodies are
 // converted in parallel in the calling thread's TBB arena.
 
-/// SoA to packed: every field. U is T or const T. A rigid view whose
+/// The packed record of a SoA view's model, and the SoA view of a record's.
+template <class View>
+struct RecordOf;
+template <class U>
+struct RecordOf<BodyView<U>> {
+  using type = PackedRigid<std::remove_const_t<U>>;
+};
+template <class U>
+struct RecordOf<SphereView<U>> {
+  using type = PackedSphere<std::remove_const_t<U>>;
+};
+template <class U>
+struct RecordOf<ParticleView<U>> {
+  using type = PackedParticle<std::remove_const_t<U>>;
+};
+template <class Record>
+struct SoaViewOf;
+template <class T>
+struct SoaViewOf<PackedRigid<T>> {
+  using type = BodyView<T>;
+};
+template <class T>
+struct SoaViewOf<PackedSphere<T>> {
+  using type = SphereView<T>;
+};
+template <class T>
+struct SoaViewOf<PackedParticle<T>> {
+  using type = ParticleView<T>;
+};
+
+/// SoA to packed: every field. View is a BodyView, SphereView or
+/// ParticleView of T or const T, the records its model's. A rigid view whose
 /// inv_mass is the SoA's own array (the solver packs that way) leaves it as
 /// it is.
-template <class U>
-void pack(const BodyView<U>& from, const PackedView<PackedRigid<std::remove_const_t<U>>>& to);
-template <class U>
-void pack(const SphereView<U>& from, const PackedView<PackedSphere<std::remove_const_t<U>>>& to);
-template <class U>
-void pack(const ParticleView<U>& from, const PackedView<PackedParticle<std::remove_const_t<U>>>& to);
+template <class View>
+void pack(const View& from, const PackedView<typename RecordOf<View>::type>& to);
 
 /// Packed to SoA: every field.
-template <class T>
-void unpack(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to);
-template <class T>
-void unpack(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to);
-template <class T>
-void unpack(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to);
+template <class Record>
+void unpack(const PackedView<Record>& from, const typename SoaViewOf<Record>::type& to);
 
 /// Packed to SoA: only what the kernels write (v, and w where the model has
 /// it), and only for movable bodies (inverse mass != 0): the rest did not
 /// change.
-template <class T>
-void unpack_velocities(const PackedView<PackedRigid<T>>& from, const BodyView<T>& to);
-template <class T>
-void unpack_velocities(const PackedView<PackedSphere<T>>& from, const SphereView<T>& to);
-template <class T>
-void unpack_velocities(const PackedView<PackedParticle<T>>& from, const ParticleView<T>& to);
+template <class Record>
+void unpack_velocities(const PackedView<Record>& from, const typename SoaViewOf<Record>::type& to);
 
 /// The body layout a solve runs on (SolverOptions::layout).
 enum class BodyLayout {

@@ -39,6 +39,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
+#include <variant>
 
 #include "collide/model.hpp"
 #include "contact_kernel.hpp"
@@ -66,46 +68,32 @@ COLLIDE_LANE_INLINE V contact_field(const T* field, const ContactGroup& g) {
   return g.contiguous ? load<V>(field + g.first) : gather<V>(field, g.index);
 }
 
-/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes (v
-/// and w): the lanes of `a` and `b` are read into (BodyLanes) or written
-/// from (const BodyLanes).
+/// Calls f(field, lane_of_a, lane_of_b) for every field the model writes (the
+/// velocities, ArrayRole::velocity): the lanes of `a` and `b` are read into
+/// (BodyLanes) or written from (const BodyLanes).
 template <class M, class View, class Lanes, class F>
 COLLIDE_LANE_INLINE void velocity_fields(const View& view, Lanes& a, Lanes& b, F&& f) {
-  f(view.v.x, a.v.x, b.v.x);
-  f(view.v.y, a.v.y, b.v.y);
-  f(view.v.z, a.v.z, b.v.z);
-  if constexpr (kRotates<M>) {
-    f(view.w.x, a.w.x, b.w.x);
-    f(view.w.y, a.w.y, b.w.y);
-    f(view.w.z, a.w.z, b.w.z);
-  }
+  for_each_lane_field<View>([&](auto at) COLLIDE_LANE_LAMBDA {
+    using At = decltype(at);
+    if constexpr (At::field.role == ArrayRole::velocity) f(At::of(view), At::of(a), At::of(b));
+  });
 }
 
 /// Calls f(field, lane_of_a, lane_of_b) for every input field of the model,
-/// so that the index gather and the paired load share one field list.
+/// so that the index gather and the paired load share one field list (the
+/// model's table); then forms a rigid body's rotation from q.
 template <class M, class V, bool kVelocities = true, class View, class F>
 COLLIDE_LANE_INLINE void read_bodies(const View& view, BodyLanes<M, V>& a, BodyLanes<M, V>& b, F&& f) {
-  f(view.inv_mass, a.inv_mass, b.inv_mass);
-  if constexpr (std::is_same_v<M, RigidModel>) {
-    f(view.inv_inertia.x, a.inv_inertia.x, b.inv_inertia.x);
-    f(view.inv_inertia.y, a.inv_inertia.y, b.inv_inertia.y);
-    f(view.inv_inertia.z, a.inv_inertia.z, b.inv_inertia.z);
-    f(view.q.w, a.q.w, b.q.w);
-    f(view.q.x, a.q.x, b.q.x);
-    f(view.q.y, a.q.y, b.q.y);
-    f(view.q.z, a.q.z, b.q.z);
-    a.rotation = normalised_rotation(a.q);
-    b.rotation = normalised_rotation(b.q);
-  } else if constexpr (std::is_same_v<M, SphereModel>) {
-    f(view.inv_inertia, a.inv_inertia.x, b.inv_inertia.x);
-  }
-  if constexpr (kRotates<M>) {
-    f(view.p.x, a.p.x, b.p.x);
-    f(view.p.y, a.p.y, b.p.y);
-    f(view.p.z, a.p.z, b.p.z);
-  }
-  // Not for the geometry of a run (run_geometry): its walk reads them.
-  if constexpr (kVelocities) velocity_fields<M>(view, a, b, f);
+  // Not the velocities for the geometry of a run (run_geometry): its walk reads them.
+  for_each_lane_field<View>([&](auto at) COLLIDE_LANE_LAMBDA {
+    using At = decltype(at);
+    if constexpr (kVelocities || At::field.role != ArrayRole::velocity) f(At::of(view), At::of(a), At::of(b));
+    // The rotation as soon as q is in, while its lanes are in registers.
+    if constexpr (At::field.member == BodyMember::q && At::field.component == 3) {
+      a.rotation = normalised_rotation(a.q);
+      b.rotation = normalised_rotation(b.q);
+    }
+  });
 }
 
 /// Calls f(field, lane_of_a, lane_of_b) for every field the model writes.
@@ -766,35 +754,22 @@ inline constexpr std::size_t kModelSlot = std::is_same_v<M, ParticleModel> ? sta
                                                                            : static_cast<std::size_t>(Model::rigid);
 
 /// The job's bodies in the view of model M: its SoA view, or with kPacked
-/// its packed records.
+/// its packed records (JobBodies' order: the models, then packed). The
+/// table chose this loop by that index (job_kernels), so it is the one set.
 template <class M, bool kPacked, class T>
 COLLIDE_LANE_INLINE const auto& bodies_of(const KernelJob<T>& job) {
-  if constexpr (std::is_same_v<M, ParticleModel>) {
-    if constexpr (kPacked) {
-      return job.packed_particle;
-    } else {
-      return job.particle;
-    }
-  } else if constexpr (std::is_same_v<M, SphereModel>) {
-    if constexpr (kPacked) {
-      return job.packed_sphere;
-    } else {
-      return job.sphere;
-    }
-  } else {
-    if constexpr (kPacked) {
-      return job.packed_rigid;
-    } else {
-      return job.rigid;
-    }
-  }
+  constexpr std::size_t kIndex = kModelSlot<M> + (kPacked ? 3 : 0);
+  assert(job.bodies.index() == kIndex);
+  // Said to the compiler too, so that no loop tests the index again.
+  if (job.bodies.index() != kIndex) __builtin_unreachable();
+  return *std::get_if<kIndex>(&job.bodies);
 }
 
 /// GroupLoops::solve: the law on groups of V::size() contacts.
 template <class M, class V, class Mode, bool kFriction, bool kPacked, class T = typename V::value_type>
 COLLIDE_KERNEL_LOOP std::size_t solve_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
                                            std::size_t end) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked && job.friction == kFriction &&
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked && job.friction == kFriction &&
          job.accurate == (std::is_same_v<Mode, AccurateMode>)&&!job.stepped);
   return solve_groups<M, V, kFriction, Mode, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.order,
                                                 contiguous, job.accumulate, begin, end);
@@ -807,7 +782,7 @@ template <class M, class V, bool kPacked, class T = typename V::value_type>
 COLLIDE_KERNEL_LOOP std::size_t step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous, std::size_t begin,
                                           std::size_t end) {
   // Positions are contact indices: stepped jobs are prepared (identity order).
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked);
   assert(job.stepped && !job.accurate && !job.friction && (begin == end || job.order[begin] == begin));
   constexpr std::size_t W = V::size();
   const auto& bodies = bodies_of<M, kPacked>(job);
@@ -824,7 +799,7 @@ COLLIDE_KERNEL_LOOP std::size_t step_loop(const KernelJob<T>& job, [[maybe_unuse
 template <class M, class V, bool kFriction, bool kPacked, class T = typename V::value_type>
 COLLIDE_KERNEL_LOOP std::size_t accumulate_loop(const KernelJob<T>& job, bool contiguous, std::size_t begin,
                                                 std::size_t end) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked && job.friction == kFriction);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked && job.friction == kFriction);
   assert(job.accumulates() && !job.accurate && !job.stepped && !job.accumulate);
   constexpr std::size_t W = V::size();
   const auto& bodies = bodies_of<M, kPacked>(job);
@@ -841,7 +816,7 @@ COLLIDE_KERNEL_LOOP std::size_t accumulate_loop(const KernelJob<T>& job, bool co
 template <class M, class V, bool kPacked, class T = typename V::value_type>
 COLLIDE_KERNEL_LOOP std::size_t accumulate_step_loop(const KernelJob<T>& job, [[maybe_unused]] bool contiguous,
                                                      std::size_t begin, std::size_t end) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked);
   assert(job.accumulates() && job.stepped && !job.accurate && !job.friction && !job.accumulate);
   assert(begin == end || job.order[begin] == begin);
   constexpr std::size_t W = V::size();
@@ -855,7 +830,7 @@ COLLIDE_KERNEL_LOOP std::size_t accumulate_step_loop(const KernelJob<T>& job, [[
 /// geometry in the lanes of this ISA.
 template <class M, class T, bool kPacked>
 COLLIDE_KERNEL_LOOP void run_loop(const KernelJob<T>& job, std::size_t begin, std::size_t end) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked);
   assert(!job.accurate && !job.friction && !job.stepped);
   solve_run_pieces<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate,
                                        job.order, begin, end);
@@ -865,7 +840,7 @@ COLLIDE_KERNEL_LOOP void run_loop(const KernelJob<T>& job, std::size_t begin, st
 template <class M, class T, bool kPacked>
 COLLIDE_KERNEL_LOOP void geometry_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
                                        const GeometryView<T>& into) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked);
   assert(!job.accurate && !job.friction);
   piece_geometry<M, SimdLanes<T>, T>(bodies_of<M, kPacked>(job), job.contacts, job.order + first, count, into);
 }
@@ -874,7 +849,7 @@ COLLIDE_KERNEL_LOOP void geometry_loop(const KernelJob<T>& job, std::size_t firs
 template <class M, class T, bool kPacked>
 COLLIDE_KERNEL_LOOP void walk_loop(const KernelJob<T>& job, std::size_t first, std::size_t count,
                                    const GeometryView<T>& geometry) {
-  assert(job.model == static_cast<Model>(kModelSlot<M>) && job.packed == kPacked);
+  assert(job.model() == static_cast<Model>(kModelSlot<M>) && job.packed() == kPacked);
   assert(!job.accurate && !job.friction);
   piece_walk<M, T>(bodies_of<M, kPacked>(job), job.contacts, job.impulses, job.accumulate, job.order + first, count,
                    geometry);
