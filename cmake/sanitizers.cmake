@@ -12,7 +12,14 @@
 #   * -fno-sanitize-recover=all: UBSan otherwise prints a report and carries
 #     on, and the test passes; with it the first UB aborts the process, so a
 #     ctest run or a fuzzer fails on it.
-#   * -fno-omit-frame-pointer -g: readable stacks in the reports.
+#   * -fno-omit-frame-pointer and, under ASan and UBSan, line tables only
+#     (Clang's -gline-tables-only, GCC's -g1): readable stacks in the
+#     reports, file and line of every frame. Full debug information adds the
+#     types and variables, which no report prints, and costs a sixth of the
+#     compile time of a test or kernel unit besides much larger objects to
+#     link (decision 0047). TSan keeps -g: its suppressions
+#     (tests/tsan/tbb.supp) match TBB's frames by their qualified names,
+#     which the line tables do not hold for inlined functions.
 #   * -O1: the kernel units (core/src/kernel/) instantiate the kernel for
 #     3 models x 2 paths x 2 precisions x friction; at -O0 with
 #     instrumentation the tests run many times slower and at -O2/-O3 the
@@ -39,8 +46,15 @@
 if(COLLIDE_SANITIZE)
   string(REPLACE ";" "," _collide_sanitize "${COLLIDE_SANITIZE}")
   message(STATUS "collide: sanitizers ${_collide_sanitize} (${COLLIDE_SANITIZE_OPT})")
-  add_compile_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all -fno-omit-frame-pointer -g
-                      ${COLLIDE_SANITIZE_OPT})
+  if(_collide_sanitize MATCHES "thread")
+    set(_collide_line_tables -g)
+  elseif(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    set(_collide_line_tables -gline-tables-only)
+  else()
+    set(_collide_line_tables -g1)
+  endif()
+  add_compile_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all -fno-omit-frame-pointer
+                      ${_collide_line_tables} ${COLLIDE_SANITIZE_OPT})
   add_link_options(-fsanitize=${_collide_sanitize} -fno-sanitize-recover=all)
   if(_collide_sanitize MATCHES "undefined")
     set(COLLIDE_KERNEL_SANITIZE_OPTIONS -fno-sanitize=pointer-overflow)
@@ -53,6 +67,7 @@ if(COLLIDE_SANITIZE)
     add_compile_definitions(TBB_USE_PROFILING_TOOLS=2)
   endif()
   unset(_collide_sanitize)
+  unset(_collide_line_tables)
 endif()
 
 if(COLLIDE_BUILD_FUZZ)
