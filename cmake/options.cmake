@@ -7,6 +7,8 @@
 #   COLLIDE_BUILD_IO        collide::io (scene files, generators)
 #   COLLIDE_BUILD_EVAL      collide::eval (reference, error measures)
 #   COLLIDE_BUILD_TESTS     the tests (tests/)
+#   COLLIDE_TESTS_PER_CASE  one ctest test per GoogleTest case, or per program
+#   COLLIDE_USE_LLD         link with lld where the compiler can (cmake/flags.cmake)
 #   COLLIDE_BUILD_BENCH     the benchmarks (bench/)
 #   COLLIDE_BUILD_CLI       the `collide` tool (cli/)
 #   COLLIDE_BUILD_PYTHON    the Python extension (python/; needs pybind11)
@@ -104,6 +106,15 @@ option(COLLIDE_BUILD_CLI "Build the collide command-line tool" ${_collide_tools_
 option(COLLIDE_BUILD_PYTHON "Build the Python extension (needs pybind11)" ${_collide_tools_default})
 option(COLLIDE_BUILD_EXAMPLES "Build the examples" ${_collide_tools_default})
 option(COLLIDE_BUILD_FUZZ "Build the libFuzzer targets (needs clang)" OFF)
+# How the GoogleTest programs reach ctest (tests/CMakeLists.txt): ON, each
+# case its own ctest test in its own process (gtest_discover_tests), so ctest
+# names, filters and times every case; OFF, each program one ctest test
+# running all its cases in one process. The `asan` preset turns it off: a
+# sanitized process spends a large part of a short case starting (mapping
+# its shadow memory and loading a large program), and one start per program
+# instead of one per case shortens the sanitized test run (decision 0049).
+option(COLLIDE_USE_LLD "Link collide's programs with lld where the compiler can use it" ON)
+option(COLLIDE_TESTS_PER_CASE "Register each GoogleTest case as its own ctest test (OFF: one test per program)" ON)
 # Unity batches are CMake's own: -DCMAKE_UNITY_BUILD=ON (UNITY_BUILD of every
 # target, 8 sources a batch; the kernel objects, one source each, and the
 # tests stay out: core/CMakeLists.txt, tests/CMakeLists.txt). The libraries'

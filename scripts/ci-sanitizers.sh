@@ -5,7 +5,9 @@
 #   1. ASan + UBSan: one Clang build (no Python module: a sanitized extension
 #      cannot load into an unsanitized interpreter; Debug, so the kernels' asserts are on,
 #      at -O1; see cmake/sanitizers.cmake) of the library, the CLI, every test
-#      and the fuzzers, then ctest. The `objects` test (test_isa_objects: it
+#      and the fuzzers, then ctest, one ctest test per test program (each
+#      runs all its cases in one sanitized process: COLLIDE_TESTS_PER_CASE,
+#      decision 0049). The `objects` test (test_isa_objects: it
 #      inspects the optimised objects the project ships) and the `package`
 #      tests are left out; the latter
 #      install the library and build consumers without sanitizer flags (which

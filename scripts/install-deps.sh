@@ -17,7 +17,9 @@ tool=(g++ cmake make ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox lib
 # The rest: Eigen (the tests' cross-check and the benchmarks' lane
 # comparison), Google Benchmark and GoogleTest.
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
-# scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh.
+# scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh. lld: the
+# linker of the tests' fifty programs, several times faster than GNU ld
+# (cmake/flags.cmake; the build falls back to GNU ld without it).
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
 # tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
 # no network (venv, setuptools, pip).
@@ -25,7 +27,7 @@ tool=(g++ cmake make ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox lib
 # the solve split across Dask workers by islands and solve_scenes' table, and its
 # tests on a LocalCluster (tests/python/test_dask.py); `import collide` does not need them.
 rest=(libeigen3-dev libbenchmark-dev libgtest-dev
-  clang-14 libclang-rt-14-dev clang-tidy-14
+  clang-14 libclang-rt-14-dev clang-tidy-14 lld
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib python3-venv python3-setuptools python3-pip
   python3-dask python3-distributed python3-pandas)
 
