@@ -113,8 +113,10 @@ option(COLLIDE_BUILD_FUZZ "Build the libFuzzer targets (needs clang)" OFF)
 # sanitized process spends a large part of a short case starting (mapping
 # its shadow memory and loading a large program), and one start per program
 # instead of one per case shortens the sanitized test run (decision 0049).
-option(COLLIDE_USE_LLD "Link collide's programs with lld where the compiler can use it" ON)
 option(COLLIDE_TESTS_PER_CASE "Register each GoogleTest case as its own ctest test (OFF: one test per program)" ON)
+# The linker of collide's own programs: lld where the compiler can use it,
+# else the compiler's default (cmake/flags.cmake says why).
+option(COLLIDE_USE_LLD "Link collide's programs with lld where the compiler can use it" ON)
 # Unity batches are CMake's own: -DCMAKE_UNITY_BUILD=ON (UNITY_BUILD of every
 # target, 8 sources a batch; the kernel objects, one source each, and the
 # tests stay out: core/CMakeLists.txt, tests/CMakeLists.txt). The libraries'
