@@ -89,9 +89,9 @@ target_compile_options(collide_kernel_placement INTERFACE -falign-functions=64 -
 # ---------------------------------------------------------------------------
 # The linker: LLVM's lld (Debian lld) where the compiler can use it, GNU ld
 # otherwise. The tests are some fifty programs, each linking the static
-# libraries with every kernel unit; lld links one of them in a third to a
-# quarter of GNU ld's time, most in the sanitized builds, whose programs are
-# largest (decision 0049). The program is the same: the linker places the
+# libraries with every kernel unit, and lld links them several times faster
+# than GNU ld where the programs are largest, in the sanitized builds
+# (decision 0049 has the times). The program is the same: the linker places the
 # objects' code, it does not change it. COLLIDE_USE_LLD=OFF keeps the
 # compiler's default. Only collide's own build: an embedding project
 # (add_subdirectory) keeps its linker.

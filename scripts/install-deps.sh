@@ -18,8 +18,8 @@ tool=(g++ cmake make ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox lib
 # comparison), Google Benchmark and GoogleTest.
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
 # scripts/ci-sanitizers.sh; clang-tidy-14: scripts/clang-tidy.sh. lld: the
-# linker of the tests' fifty programs, several times faster than GNU ld
-# (cmake/flags.cmake; the build falls back to GNU ld without it).
+# linker of the tests' fifty programs, faster than GNU ld (cmake/flags.cmake;
+# the build falls back to GNU ld without it).
 # pybind11-dev and the python3-* packages: the Python extension (python/), its
 # tests (pytest) and examples (matplotlib), and `pip install .` in a venv with
 # no network (venv, setuptools, pip).
