@@ -886,11 +886,12 @@ void add_step_loops(GroupLoops<typename V::value_type>& loops) {
   loops.step[kModelSlot<M>][1] = &step_loop<M, V, true>;
 }
 
-/// The slots of one kernel unit in the lanes of this ISA: model M's loops
-/// of precision T in mode Mode; the fast mode's unit also holds the loops
+/// The slots of one kernel unit in the lanes of this ISA's table: model M's
+/// loops of precision T in mode Mode; the fast mode's unit also holds the loops
 /// that only the fast mode has (the velocity step and the run's).
 template <class M, class T, class Mode>
-void add_unit_loops(KernelLoops<T>& loops) {
+void add_unit_loops(KernelTable& table) {
+  KernelLoops<T>& loops = *of_precision<T>(&table.loops_float, &table.loops_double);
   add_solve_loops<M, SimdLanes<T>, Mode>(loops.groups);
   if constexpr (std::is_same_v<Mode, FastMode>) {
     constexpr std::size_t m = kModelSlot<M>;

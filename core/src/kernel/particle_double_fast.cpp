@@ -8,9 +8,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_particle_double_fast(KernelTable& table) {
-  add_unit_loops<ParticleModel, double, FastMode>(table.loops_double);
-}
+void add_particle_double_fast(KernelTable& table) { add_unit_loops<ParticleModel, double, FastMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

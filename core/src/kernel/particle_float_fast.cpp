@@ -8,7 +8,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_particle_float_fast(KernelTable& table) { add_unit_loops<ParticleModel, float, FastMode>(table.loops_float); }
+void add_particle_float_fast(KernelTable& table) { add_unit_loops<ParticleModel, float, FastMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

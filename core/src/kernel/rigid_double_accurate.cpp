@@ -7,9 +7,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_rigid_double_accurate(KernelTable& table) {
-  add_unit_loops<RigidModel, double, AccurateMode>(table.loops_double);
-}
+void add_rigid_double_accurate(KernelTable& table) { add_unit_loops<RigidModel, double, AccurateMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

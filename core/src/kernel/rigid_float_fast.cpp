@@ -8,7 +8,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_rigid_float_fast(KernelTable& table) { add_unit_loops<RigidModel, float, FastMode>(table.loops_float); }
+void add_rigid_float_fast(KernelTable& table) { add_unit_loops<RigidModel, float, FastMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

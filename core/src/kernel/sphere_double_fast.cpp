@@ -8,7 +8,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_sphere_double_fast(KernelTable& table) { add_unit_loops<SphereModel, double, FastMode>(table.loops_double); }
+void add_sphere_double_fast(KernelTable& table) { add_unit_loops<SphereModel, double, FastMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

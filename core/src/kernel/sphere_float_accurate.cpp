@@ -7,9 +7,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_sphere_float_accurate(KernelTable& table) {
-  add_unit_loops<SphereModel, float, AccurateMode>(table.loops_float);
-}
+void add_sphere_float_accurate(KernelTable& table) { add_unit_loops<SphereModel, float, AccurateMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail

@@ -8,7 +8,7 @@
 namespace collide::detail {
 inline namespace COLLIDE_KERNEL_NS {
 
-void add_sphere_float_fast(KernelTable& table) { add_unit_loops<SphereModel, float, FastMode>(table.loops_float); }
+void add_sphere_float_fast(KernelTable& table) { add_unit_loops<SphereModel, float, FastMode>(table); }
 
 }  // namespace COLLIDE_KERNEL_NS
 }  // namespace collide::detail
