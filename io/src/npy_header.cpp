@@ -32,10 +32,8 @@
 namespace collide {
 namespace {
 
-using detail::kAllTypes;
-using detail::kNpyMagic;
-using detail::load_le;
-using detail::quoted_text;
+// The archive's and the arrays' fixed fields (npz_format.hpp).
+using namespace detail::npz;
 
 constexpr std::string_view kSupportedDtypes = "'<f4', '<f8', '<u4', '<i4', '<u8' or '<i8'";
 

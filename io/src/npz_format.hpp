@@ -19,7 +19,7 @@
 
 #include "collide/io/npz.hpp"
 
-namespace collide::detail {
+namespace collide::detail::npz {
 
 /// Every NpyType: the dtypes a column may have.
 inline constexpr std::array<NpyType, 6> kAllTypes = {NpyType::f4, NpyType::f8, NpyType::u4,
@@ -74,4 +74,4 @@ inline std::uint64_t load_le(const char* p, int bytes) {
   return v;
 }
 
-}  // namespace collide::detail
+}  // namespace collide::detail::npz

@@ -49,22 +49,8 @@ static_assert(std::endian::native == std::endian::little, "collide reads .npy da
 
 namespace {
 
-using detail::kCentralHeaderSignature;
-using detail::kCentralHeaderSize;
-using detail::kEndSignature;
-using detail::kEndSize;
-using detail::kLocalHeaderSignature;
-using detail::kLocalHeaderSize;
-using detail::kNpySuffix;
-using detail::kZip16Max;
-using detail::kZip32Max;
-using detail::kZip64EndSignature;
-using detail::kZip64EndSize;
-using detail::kZip64ExtraId;
-using detail::kZip64LocatorSignature;
-using detail::kZip64LocatorSize;
-using detail::load_le;
-using detail::quoted_text;
+// The archive's and the arrays' fixed fields (npz_format.hpp).
+using namespace detail::npz;
 
 /// Little-endian fields of a byte range that the caller has checked is
 /// long enough.

@@ -49,20 +49,8 @@
 namespace collide {
 namespace {
 
-using detail::kAllTypes;
-using detail::kCentralHeaderSignature;
-using detail::kEndSignature;
-using detail::kEndSize;
-using detail::kLocalHeaderSignature;
-using detail::kLocalHeaderSize;
-using detail::kNpyMagic;
-using detail::kNpySuffix;
-using detail::kZip16Max;
-using detail::kZip32Max;
-using detail::kZip64EndSignature;
-using detail::kZip64EndSize;
-using detail::kZip64ExtraId;
-using detail::kZip64LocatorSignature;
+// The archive's and the arrays' fixed fields (npz_format.hpp).
+using namespace detail::npz;
 
 // Fixed fields: every archive of the same columns has the same bytes.
 constexpr std::uint16_t kVersionNeeded = 45;                          // 4.5: ZIP64
