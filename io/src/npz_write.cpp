@@ -116,6 +116,22 @@ struct WrittenMember {
   std::uint16_t flags;
 };
 
+/// The fields the local header and the central directory's entry share, in
+/// the order both write them (APPNOTE 4.3.7 and 4.3.12, from "version needed
+/// to extract" to "file name length"): stored, not compressed; the sizes
+/// in the ZIP64 extra block.
+void put_member_fields(std::string& out, const WrittenMember& member) {
+  put16(out, kVersionNeeded);
+  put16(out, member.flags);
+  put16(out, 0);  // stored
+  put16(out, kDosTime);
+  put16(out, kDosDate);
+  put32(out, member.crc);
+  put32(out, kZip32Max);  // compressed size: in the ZIP64 block
+  put32(out, kZip32Max);  // uncompressed size: in the ZIP64 block
+  put16(out, static_cast<std::uint16_t>(member.name.size()));
+}
+
 void check_columns(const std::vector<NpzColumn>& columns) {
   std::unordered_set<std::string_view> names;
   for (const NpzColumn& column : columns) {
@@ -181,15 +197,7 @@ void write_archive(const std::vector<NpzColumn>& columns, Sink&& sink) {
 
     std::string local;
     put32(local, kLocalHeaderSignature);
-    put16(local, kVersionNeeded);
-    put16(local, member.flags);
-    put16(local, 0);  // stored
-    put16(local, kDosTime);
-    put16(local, kDosDate);
-    put32(local, member.crc);
-    put32(local, kZip32Max);  // compressed size: in the ZIP64 block
-    put32(local, kZip32Max);  // uncompressed size: in the ZIP64 block
-    put16(local, static_cast<std::uint16_t>(member.name.size()));
+    put_member_fields(local, member);
     put16(local, static_cast<std::uint16_t>(kLocalZip64ExtraSize + kZipAlignExtraMin + zeros));
     local += member.name;
     put16(local, kZip64ExtraId);
@@ -212,15 +220,7 @@ void write_archive(const std::vector<NpzColumn>& columns, Sink&& sink) {
   for (const WrittenMember& member : written) {
     put32(tail, kCentralHeaderSignature);
     put16(tail, kVersionMadeBy);
-    put16(tail, kVersionNeeded);
-    put16(tail, member.flags);
-    put16(tail, 0);  // stored
-    put16(tail, kDosTime);
-    put16(tail, kDosDate);
-    put32(tail, member.crc);
-    put32(tail, kZip32Max);  // compressed size
-    put32(tail, kZip32Max);  // uncompressed size
-    put16(tail, static_cast<std::uint16_t>(member.name.size()));
+    put_member_fields(tail, member);
     put16(tail, static_cast<std::uint16_t>(kCentralZip64ExtraSize));
     put16(tail, 0);  // comment length
     put16(tail, 0);  // disk number
