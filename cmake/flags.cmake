@@ -74,14 +74,14 @@ endif()
 # and every loop starts on a 64-byte boundary (a cache line, and a whole
 # number of the front end's fetch blocks). The speed of a kernel loop moved
 # with where it landed: a change to one loop moved the code after it, and
-# an unchanged loop's speed with it, by up to 1.39x
+# an unchanged loop's speed with it
 # (docs/decisions/0036-the-avx512-gather-instruction-measured.md). Each loop
 # is its own function (core/src/kernel_table.hpp); aligned, a function's
 # start and its hot loops sit at the same offsets in their lines whatever
 # precedes them in the object, so placing or changing one variant does not
-# move another's speed. The padding is under 1% of the code (0.4% of the
-# AVX-512 rigid float fast unit's). Clang 14 accepts both flags too (the
-# sanitizer build).
+# move another's speed. What it costs is padding: the gaps before each
+# function and hot loop, in the kernel objects only. Clang 14 accepts both
+# flags too (the sanitizer build).
 # ---------------------------------------------------------------------------
 add_library(collide_kernel_placement INTERFACE)
 target_compile_options(collide_kernel_placement INTERFACE -falign-functions=64 -falign-loops=64)
