@@ -43,6 +43,12 @@ class CMakeBuild(build_ext):
             "-DCOLLIDE_BUILD_EXAMPLES=OFF", "-DCOLLIDE_INSTALL=OFF", "-DCOLLIDE_BUILD_PYTHON=ON",
             "-DPython3_EXECUTABLE=" + sys.executable,
         ]
+        # Ninja where it is installed, as the presets build (CMakePresets.json):
+        # the same generator lays the objects out as the normal build does, so
+        # ccache finds them. A build directory another generator made keeps it.
+        cache = os.path.join(build_dir, "CMakeCache.txt")
+        if shutil.which("ninja") and not os.path.exists(cache):
+            configure += ["-G", "Ninja"]
         env = dict(os.environ)
         if shutil.which("ccache"):
             configure.append("-DCMAKE_CXX_COMPILER_LAUNCHER=ccache")

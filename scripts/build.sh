@@ -41,6 +41,12 @@ if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
 fi
+# CMake does not switch a build directory's generator in place: a build/
+# that Make configured (before the presets named Ninja) loses its cache and
+# is configured anew; ccache gives its objects back.
+if [ -f "$root/build/CMakeCache.txt" ] && ! grep -qx 'CMAKE_GENERATOR:INTERNAL=Ninja' "$root/build/CMakeCache.txt"; then
+  rm -rf "$root/build/CMakeCache.txt" "$root/build/CMakeFiles"
+fi
 cmake -S "$root" --preset "$preset" "${launcher[@]}" "${configure[@]}" >/dev/null
 # A build preset is read from the source directory's CMakePresets.json.
 (cd "$root" && cmake --build --preset "$preset" -j"$(nproc)" "${targets[@]}")

@@ -63,6 +63,13 @@ if command -v ccache >/dev/null; then
   export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
 fi
 stage() { printf '\n== %s (%ss since start)\n' "$1" "$SECONDS"; }
+# A build directory that Make configured (before the presets named Ninja)
+# loses its cache: CMake does not switch generators in place.
+for dir in "$root/build-asan" "$root/build-tsan"; do
+  if [ -f "$dir/CMakeCache.txt" ] && ! grep -qx 'CMAKE_GENERATOR:INTERNAL=Ninja' "$dir/CMakeCache.txt"; then
+    rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+  fi
+done
 
 # --- 1. ASan + UBSan --------------------------------------------------------
 asan="$root/build-asan"

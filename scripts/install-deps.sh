@@ -13,7 +13,10 @@ set -euo pipefail
 # libbullet-dev gives `collide report` its peer row (optional in CMake).
 # ccache: scripts/build.sh and setup.py compile through it when present, so the
 # pip install test reuses the normal build's objects (python/CMakeLists.txt).
-tool=(g++ cmake make ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox libbullet-dev)
+# ninja-build: the presets' generator (CMakePresets.json): it compiles a
+# target's sources while the libraries it links are still compiling, where
+# Make waits for each library, so both cores stay busy (decision 0050).
+tool=(g++ cmake make ninja-build ccache pkg-config libtbb-dev libdeflate-dev gnuplot-nox libbullet-dev)
 # The rest: Eigen (the tests' cross-check and the benchmarks' lane
 # comparison), Google Benchmark and GoogleTest.
 # clang-14 and its runtimes: the ASan/UBSan, TSan and libFuzzer builds of
