@@ -160,13 +160,14 @@ elseif(MODE STREQUAL "add_subdirectory")
   # kernel's forced inlining and its debug information take longer still to
   # compile: docs/decisions/0032-the-double-accurate-law-out-of-line.md.)
   #
-  # The embedded tree is a copy of the checkout's files with collide's binary
-  # directory one level under it, as build/ is under the checkout, and the
-  # compiler cache's base directory at the copy: the kernel units' compile
-  # commands are then, relative to their directories, those of the build
-  # under test, and a cache that build filled (scripts/build.sh) serves them.
-  # Outside a git checkout the tree itself is added and everything compiles.
-  set(dir ${WORK_DIR}/add_subdirectory)
+  # The embedded tree is a copy of the checkout's files with the consumer's
+  # build directory one level under it, as build/ is under the checkout, and
+  # the compiler cache's base directory at the copy. Ninja compiles from the
+  # top of the build directory, so the kernel units' compile commands are
+  # then, relative to it, those of the build under test, and a cache that
+  # build filled (scripts/build.sh) serves them (the object's own path is
+  # not part of ccache's key). Outside a git checkout the tree itself is
+  # added and everything compiles.
   set(shared_prefix ${WORK_DIR}/shared-prefix)
   set(tree ${WORK_DIR}/embedded-src)
   fresh_dir(${tree})
@@ -181,11 +182,13 @@ elseif(MODE STREQUAL "add_subdirectory")
       endif()
     endforeach()
     set(ENV{CCACHE_BASEDIR} ${tree})
+    set(dir ${tree}/build)
   else()
     set(tree ${SOURCE_DIR})
+    set(dir ${WORK_DIR}/add_subdirectory)
   endif()
-  build_and_run_consumer(${dir} -DCOLLIDE_SOURCE_DIR=${tree} -DCOLLIDE_BINARY_DIR=${tree}/build-embedded
-                         -DCONSUMER_CORE_ONLY=ON -DBUILD_SHARED_LIBS=ON -DCOLLIDE_INSTALL=ON -DCOLLIDE_KERNEL_ISAS=sse2)
+  build_and_run_consumer(${dir} -DCOLLIDE_SOURCE_DIR=${tree} -DCONSUMER_CORE_ONLY=ON
+                         -DBUILD_SHARED_LIBS=ON -DCOLLIDE_INSTALL=ON -DCOLLIDE_KERNEL_ISAS=sse2)
   file(REMOVE_RECURSE ${shared_prefix})
   run("install shared collide" COMMAND ${CMAKE_COMMAND} --install ${dir} --prefix ${shared_prefix})
   check_installed(${shared_prefix} SHARED_LIBRARY core)
