@@ -314,21 +314,6 @@ COLLIDE_LANE_INLINE void store_group_impulses(const ImpulseView<T>& impulses, co
   }
 }
 
-/// What the law reads of one group's contacts (ContactLanes): the points
-/// where the model rotates, the normals, the restitution (per contact or
-/// the scene's), the friction coefficients where the loop has friction.
-template <class M, class V, bool kFriction, class T>
-COLLIDE_LANE_INLINE ContactLanes<V> load_group_contacts(const ContactView<T>& contacts, const ContactGroup& g) {
-  ContactLanes<V> c;
-  if constexpr (kRotates<M>) {
-    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
-  }
-  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
-  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
-  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
-  return c;
-}
-
 /// Resolves one group of V::size() contacts; with `accumulate`, adds J to
 /// the impulses there (a later pass).
 template <class M, class V, bool kFriction, class Mode, bool kPaired, class T, class View>
@@ -338,7 +323,13 @@ COLLIDE_LANE_INLINE void solve_group(const View& bodies, const ContactView<T>& c
   BodyLanes<M, V> b;
   load_group_bodies<M, V, T, false, kPaired>(bodies, at, a, b);
 
-  const ContactLanes<V> c = load_group_contacts<M, V, kFriction>(contacts, g);
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
 
   const ContactResult<V> r = resolve_contacts<M, V, kFriction, Mode>(a, b, c);
   store_group_bodies<M, V, T, kPaired>(bodies, at, a, b);
@@ -380,24 +371,6 @@ COLLIDE_LANE_INLINE void store_accumulated(const AccumulatedView<T>& view, const
   }
 }
 
-/// A warm start's visit of one group (KernelJob::warm, on the first pass):
-/// the targets measured, or the stored totals applied to the bodies; the
-/// totals stored back, no J written. Shared by the loops that form the
-/// geometry and the loops that read it formed.
-template <class M, class V, bool kFriction, class T, class View>
-COLLIDE_LANE_INLINE void warm_visit(const View& bodies, const KernelJob<T>& job, const ContactGroup& g,
-                                    const GroupBodies<V::size()>& at, BodyLanes<M, V>& a, BodyLanes<M, V>& b,
-                                    const ContactLanes<V>& c, const ContactGeometry<V>& geo) {
-  Accumulated<V> acc = load_accumulated<V, kFriction>(job.accumulated, g);
-  if (job.warm == WarmVisit::targets) {
-    warm_start_target(a, b, c, geo, acc);
-  } else {
-    warm_start_step<M, V, kFriction>(a, b, c, geo, acc);
-    store_group_bodies<M, V, T>(bodies, at, a, b);
-  }
-  store_accumulated<V, kFriction>(job.accumulated, g, acc);
-}
-
 /// One accumulated pass of one group of V::size() contacts (KernelJob::
 /// accumulates): the first pass's law recording the totals, or a later
 /// pass moving them; J is written, not added. A warm start's visits
@@ -410,12 +383,26 @@ COLLIDE_LANE_INLINE void accumulate_group(const View& bodies, const KernelJob<T>
   BodyLanes<M, V> b;
   load_group_bodies<M, V, T>(bodies, at, a, b);
   const ContactView<T>& contacts = job.contacts;
-  const ContactLanes<V> c = load_group_contacts<M, V, kFriction>(contacts, g);
+  ContactLanes<V> c;
+  if constexpr (kRotates<M>) {
+    c.c = {contact_field<V>(contacts.c.x, g), contact_field<V>(contacts.c.y, g), contact_field<V>(contacts.c.z, g)};
+  }
+  c.n = {contact_field<V>(contacts.n.x, g), contact_field<V>(contacts.n.y, g), contact_field<V>(contacts.n.z, g)};
+  c.e = contacts.e ? contact_field<V>(contacts.e, g) : V(contacts.uniform_e);
+  if constexpr (kFriction) c.mu = contact_field<V>(contacts.mu, g);
+  Accumulated<V> acc;
   if (job.first_pass && job.warm != WarmVisit::none) {
-    warm_visit<M, V, kFriction, T>(bodies, job, g, at, a, b, c, contact_geometry(a, b, c));
+    acc = load_accumulated<V, kFriction>(job.accumulated, g);
+    const ContactGeometry<V> geo = contact_geometry(a, b, c);
+    if (job.warm == WarmVisit::targets) {
+      warm_start_target(a, b, c, geo, acc);
+    } else {
+      warm_start_step<M, V, kFriction>(a, b, c, geo, acc);
+      store_group_bodies<M, V, T>(bodies, at, a, b);
+    }
+    store_accumulated<V, kFriction>(job.accumulated, g, acc);
     return;
   }
-  Accumulated<V> acc;
   ContactResult<V> r;
   if (job.first_pass) {
     r = first_accumulated_pass<M, V, kFriction>(a, b, c, acc);
@@ -489,11 +476,18 @@ COLLIDE_LANE_INLINE void accumulate_step_group(const View& bodies, const KernelJ
   ContactLanes<V> c;
   c.n = {load<V>(contacts.n.x + first), load<V>(contacts.n.y + first), load<V>(contacts.n.z + first)};
   c.e = contacts.e ? load<V>(contacts.e + first) : V(contacts.uniform_e);
+  Accumulated<V> acc;
   if (job.first_pass && job.warm != WarmVisit::none) {
-    warm_visit<M, V, false, T>(bodies, job, g, at, a, b, c, geo);
+    acc = load_accumulated<V, false>(job.accumulated, g);
+    if (job.warm == WarmVisit::targets) {
+      warm_start_target(a, b, c, geo, acc);
+    } else {
+      warm_start_step<M, V, false>(a, b, c, geo, acc);
+      store_group_bodies<M, V, T>(bodies, at, a, b);
+    }
+    store_accumulated<V, false>(job.accumulated, g, acc);
     return;
   }
-  Accumulated<V> acc;
   ContactResult<V> r;
   if (job.first_pass) {
     r = first_accumulated_step<M, V, false>(a, b, c, geo, acc);
