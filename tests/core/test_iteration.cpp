@@ -32,6 +32,7 @@
 #include "collide/isa.hpp"
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
+#include "support/generated_scenes.hpp"
 #include "support/solve_helpers.hpp"
 
 namespace collide::test {
@@ -53,11 +54,7 @@ std::pair<BodyBuffer<T>, ImpulseBuffer<T>> solved(const Scene<T>& scene, Model m
 
 template <class T>
 Scene<T> debris(bool friction, Model model = Model::rigid) {
-  GenerateOptions o;
-  o.seed = 11;
-  o.friction = friction;
-  o.model = model;
-  return generate_debris<T>(6000, o);
+  return generated_debris<T>(6000, 11, friction, model);
 }
 
 template <class T>

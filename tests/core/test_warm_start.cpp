@@ -34,6 +34,7 @@
 #include "collide/schedule.hpp"
 #include "collide/solve.hpp"
 #include "collide/validate.hpp"
+#include "support/generated_scenes.hpp"
 #include "support/solve_helpers.hpp"
 
 namespace collide::test {
@@ -65,10 +66,7 @@ SolverOptions accumulating(Path path, int threads, int passes, bool warm) {
 
 template <class T>
 Scene<T> debris(bool friction) {
-  GenerateOptions o;
-  o.seed = 23;
-  o.friction = friction;
-  return generate_debris<T>(6000, o);
+  return generated_debris<T>(6000, 23, friction);
 }
 
 template <class T>
