@@ -32,7 +32,7 @@
 namespace collide {
 namespace {
 
-// The archive's and the arrays' fixed fields (npz_format.hpp).
+// The format's constants and helpers (npz_format.hpp).
 using namespace detail::npz;
 
 constexpr std::string_view kSupportedDtypes = "'<f4', '<f8', '<u4', '<i4', '<u8' or '<i8'";

@@ -49,7 +49,7 @@ static_assert(std::endian::native == std::endian::little, "collide reads .npy da
 
 namespace {
 
-// The archive's and the arrays' fixed fields (npz_format.hpp).
+// The format's constants and helpers (npz_format.hpp).
 using namespace detail::npz;
 
 /// Little-endian fields of a byte range that the caller has checked is

@@ -49,7 +49,7 @@
 namespace collide {
 namespace {
 
-// The archive's and the arrays' fixed fields (npz_format.hpp).
+// The format's constants and helpers (npz_format.hpp).
 using namespace detail::npz;
 
 // Fixed fields: every archive of the same columns has the same bytes.
