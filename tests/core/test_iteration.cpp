@@ -19,7 +19,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -34,6 +33,7 @@
 #include "collide/solve.hpp"
 #include "support/generated_scenes.hpp"
 #include "support/solve_helpers.hpp"
+#include "support/unit_boxes.hpp"
 
 namespace collide::test {
 namespace {
@@ -132,47 +132,6 @@ TEST(Iteration, AccumulatedPassesGiveTheSameBitsOnEveryPathIsaLayoutAndThreadCou
   }
 }
 
-/// Unit boxes (m = 1 kg, I = 1/6 kg m^2) stacked on an immovable ground,
-/// every box falling at g dt after one step of gravity: contact k joins box
-/// k (from the bottom) to the box or the ground below it, at the middle of
-/// their shared face, n = +y. Contacts are listed top first, the order in
-/// which the support converges slowest.
-template <class T>
-BodyRecord<T> box_at(T y, T vy) {
-  BodyRecord<T> b;
-  b.m = 1;
-  b.I[0] = b.I[1] = b.I[2] = T(1) / 6;
-  b.p[1] = y;
-  b.v[1] = vy;
-  return b;
-}
-
-template <class T>
-BodyRecord<T> ground_at(T y) {
-  BodyRecord<T> g = box_at<T>(y, 0);
-  g.m = std::numeric_limits<T>::infinity();
-  return g;
-}
-
-template <class T>
-Scene<T> column(std::size_t boxes, T fall) {
-  Scene<T> s;
-  s.bodies.push_back(ground_at<T>(-0.5));
-  for (std::size_t i = 0; i < boxes; ++i) s.bodies.push_back(box_at<T>(T(0.5) + T(i), -fall));
-  for (std::size_t i = boxes; i-- > 0;) {
-    ContactRecord<T> c;
-    c.a = static_cast<BodyIndex>(i + 1);
-    c.b = static_cast<BodyIndex>(i);
-    c.c[1] = T(i);
-    c.n[0] = 0;
-    c.n[1] = 1;
-    c.n[2] = 0;
-    c.e = 0;
-    s.contacts.push_back(c);
-  }
-  return s;
-}
-
 TEST(Iteration, AColumnOfBoxesGetsTheSupportImpulses) {
   constexpr std::size_t kBoxes = 20;
   const double fall = 9.81 / 60;  // one step of gravity at 60 Hz [m/s]
@@ -247,18 +206,7 @@ TEST(Iteration, ABoxOnASlopeSticksBelowTheFrictionAngleAndSlidesAbove) {
 
 TEST(Iteration, RestitutionActsOnceHoweverManyPassesRun) {
   // Two free boxes meeting head on at 2 m/s, e = 0.5: they part at 1 m/s.
-  Scene<double> s;
-  s.bodies.push_back(box_at<double>(0, 1));
-  s.bodies.push_back(box_at<double>(1, -1));
-  ContactRecord<double> c;
-  c.a = 1;
-  c.b = 0;
-  c.c[1] = 0.5;
-  c.n[0] = 0;
-  c.n[1] = 1;
-  c.n[2] = 0;
-  c.e = 0.5;
-  s.contacts.push_back(c);
+  const Scene<double> s = head_on_pair<double>(-2, 0.5);
   for (const Iteration iteration : {Iteration::accumulate, Iteration::repeat}) {
     SolverOptions o;
     o.passes = 8;

@@ -36,6 +36,7 @@
 #include "collide/validate.hpp"
 #include "support/generated_scenes.hpp"
 #include "support/solve_helpers.hpp"
+#include "support/unit_boxes.hpp"
 
 namespace collide::test {
 namespace {
@@ -111,38 +112,6 @@ TEST(WarmStart, GivesTheSameBitsOnEveryPathIsaLayoutAndThreadCount) {
   }
 }
 
-/// Unit boxes (m = 1 kg, I = 1/6 kg m^2) stacked on an immovable ground,
-/// each falling at `fall` (one step of gravity): contact i, listed top
-/// first, is under the (i + 1)-th box from the top, n = +y.
-Scene<double> column(std::size_t boxes, double fall) {
-  Scene<double> s;
-  BodyRecord<double> ground;
-  ground.m = std::numeric_limits<double>::infinity();
-  ground.I[0] = ground.I[1] = ground.I[2] = 1.0 / 6;
-  ground.p[1] = -0.5;
-  s.bodies.push_back(ground);
-  for (std::size_t i = 0; i < boxes; ++i) {
-    BodyRecord<double> b;
-    b.m = 1;
-    b.I[0] = b.I[1] = b.I[2] = 1.0 / 6;
-    b.p[1] = 0.5 + static_cast<double>(i);
-    b.v[1] = -fall;
-    s.bodies.push_back(b);
-  }
-  for (std::size_t i = boxes; i-- > 0;) {
-    ContactRecord<double> c;
-    c.a = static_cast<BodyIndex>(i + 1);
-    c.b = static_cast<BodyIndex>(i);
-    c.c[1] = static_cast<double>(i);
-    c.n[0] = 0;
-    c.n[1] = 1;
-    c.n[2] = 0;
-    c.e = 0;
-    s.contacts.push_back(c);
-  }
-  return s;
-}
-
 /// The largest |J_y - (i + 1) fall| over the column's contacts, over (n fall).
 double support_error(const ImpulseBuffer<double>& j, double fall) {
   const auto v = j.view();
@@ -156,7 +125,7 @@ double support_error(const ImpulseBuffer<double>& j, double fall) {
 TEST(WarmStart, AConvergedColumnStaysConvergedInOnePass) {
   constexpr std::size_t kBoxes = 20;
   const double fall = 9.81 / 60;
-  const Scene<double> scene = column(kBoxes, fall);
+  const Scene<double> scene = column<double>(kBoxes, fall);
   const ImpulseBuffer<double> zero(kBoxes);
   for (const Order order : {Order::input, Order::colour}) {
     SCOPED_TRACE(to_string(order));
@@ -183,30 +152,6 @@ TEST(WarmStart, AConvergedColumnStaysConvergedInOnePass) {
   }
 }
 
-/// Two free unit boxes on the y axis meeting at y = 0.5 (a above b) with
-/// relative normal velocity `closing` (< 0: approaching), restitution `e`.
-Scene<double> pair(double closing, double e) {
-  Scene<double> s;
-  for (const double y : {0.0, 1.0}) {
-    BodyRecord<double> b;
-    b.m = 1;
-    b.I[0] = b.I[1] = b.I[2] = 1.0 / 6;
-    b.p[1] = y;
-    b.v[1] = y == 0.0 ? -closing / 2 : closing / 2;
-    s.bodies.push_back(b);
-  }
-  ContactRecord<double> c;
-  c.a = 1;
-  c.b = 0;
-  c.c[1] = 0.5;
-  c.n[0] = 0;
-  c.n[1] = 1;
-  c.n[2] = 0;
-  c.e = e;
-  s.contacts.push_back(c);
-  return s;
-}
-
 ImpulseBuffer<double> one_impulse(double jy) {
   ImpulseBuffer<double> j(1);
   j.view().j.y[0] = jy;
@@ -214,7 +159,7 @@ ImpulseBuffer<double> one_impulse(double jy) {
 }
 
 TEST(WarmStart, APassTakesBackWhatTheWarmStartGaveTooMuch) {
-  const Scene<double> parting = pair(1.0, 0.0);  // already separating at 1 m/s
+  const Scene<double> parting = head_on_pair(1.0, 0.0);  // already separating at 1 m/s
   const auto [bodies, j] = solved_from(parting, one_impulse(5.0), accumulating(Path::simd, 1, 1, true));
   EXPECT_EQ(j.view().j.y[0], 0.0);
   EXPECT_NEAR(bodies.view().v.y[1] - bodies.view().v.y[0], 1.0, 1e-12);
@@ -231,7 +176,7 @@ TEST(WarmStart, APassTakesBackWhatTheWarmStartGaveTooMuch) {
 
 TEST(WarmStart, RestitutionActsOnceFromAWarmStart) {
   // Meeting at 2 m/s with e = 0.5: they part at 1 m/s, J = 1.5 N s.
-  const Scene<double> impact = pair(-2.0, 0.5);
+  const Scene<double> impact = head_on_pair(-2.0, 0.5);
   for (const double start : {0.0, 1.5, 0.7}) {
     for (const int passes : {1, 8}) {
       SCOPED_TRACE("from J = " + std::to_string(start) + ", " + std::to_string(passes) + " passes");
