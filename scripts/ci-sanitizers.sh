@@ -23,7 +23,11 @@
 #      and no code of its own, and the Release stage runs every ISA's. The
 #      libraries and the tool compile in unity batches (CMAKE_UNITY_BUILD,
 #      as README command 1 builds them), so two sources of a batch that
-#      define one name fail here.
+#      define one name fail here. Test code compiles at -O0 and without
+#      libFuzzer's coverage (tests/CMakeLists.txt: the libraries keep both),
+#      and the sweeps that repeat a solve over every path, thread count and
+#      layout run a quarter of their scene (tests/support/sanitized.hpp;
+#      decision 0051).
 #   2. Fuzzing: each libFuzzer target of fuzz/ for FUZZ_SECONDS (default 45),
 #      the targets side by side on the available cores, from a scratch copy of
 #      fuzz/corpus/<target>/ (the committed seeds stay as they are). A crash,
