@@ -47,8 +47,8 @@
 # tests/CMakeLists.txt) and the kernel units (COLLIDE_KERNEL_SANITIZE_OPTIONS).
 # The units are the law in lanes, with no branch on a contact's values, and
 # the branches of their loops (a tail, a gathered or a contiguous group)
-# follow the schedule, whose code keeps its coverage; instrumented, they took
-# half of the units' compile time (decision 0051).
+# follow the schedule, whose code keeps its coverage; instrumenting them
+# cost much of the sanitized build's compile time (decision 0051).
 if(COLLIDE_SANITIZE)
   string(REPLACE ";" "," _collide_sanitize "${COLLIDE_SANITIZE}")
   message(STATUS "collide: sanitizers ${_collide_sanitize} (${COLLIDE_SANITIZE_OPT})")
