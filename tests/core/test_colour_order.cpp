@@ -324,8 +324,8 @@ template <class T>
 void expect_sequential_law(const SolveCase& p, Model model, Accuracy accuracy) {
   SCOPED_TRACE(std::string(name(p.kind)) + (p.friction ? " friction " : " ") + type_name<T>() + " " + to_string(model) +
                " " + to_string(accuracy));
-  // Every path, thread count and layout, twice: the sweep's size
-  // (support/sanitized.hpp).
+  // Solved on every path, thread count and layout, for one pass and for
+  // three: the sweep's size (support/sanitized.hpp).
   const Scene<T> scene = make_scene<T>(p.kind, sweep_contacts(20000), p.friction, model);
   // Three passes as well: without friction, in the fast mode, a prepared
   // solve then forms the law's velocity-free half once and every pass takes

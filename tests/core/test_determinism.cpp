@@ -66,7 +66,7 @@ void PrintTo(const Config& c, std::ostream* os) { *os << describe(c); }
 
 template <class T>
 Scene<T> build(const Config& cfg, const SceneOptions& o) {
-  // Every path, thread count and block, twice: the sweep's size
+  // Solved on every path, thread count, block and layout: the sweep's size
   // (support/sanitized.hpp); the chains' 1000 contacts stay whole.
   if (cfg.layout == Layout::shared) return shared_scene<T>(sweep_contacts(24000), sweep_contacts(8000), o);
   SceneRecords<T> r = pairs_records<T>(sweep_contacts(20000) + 3, o);
