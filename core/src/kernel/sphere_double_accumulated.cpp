@@ -1,0 +1,14 @@
+// kernel/sphere_double_accumulated.cpp - a kernel unit (kernel/units.hpp): the
+// sphere model's double loops of the accumulated passes (fast mode), in the
+// lanes of the ISA it is compiled for (kernel/loops.hpp; once per ISA,
+// core/CMakeLists.txt).
+#include "kernel/loops.hpp"
+#include "kernel/units.hpp"
+
+namespace collide::detail {
+inline namespace COLLIDE_KERNEL_NS {
+
+void add_sphere_double_accumulated(KernelTable& table) { add_accumulated_unit_loops<SphereModel, double>(table); }
+
+}  // namespace COLLIDE_KERNEL_NS
+}  // namespace collide::detail
