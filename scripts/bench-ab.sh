@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
 # Alternated rounds of several collide_bench builds on the same rows: each
-# round runs every build once, in the order given, so that the machine's
-# drift over the rounds falls on all of them alike. Prints one line per
+# round runs every build once, so that the machine's drift over the rounds
+# falls on all of them alike, and the order turns by one build a round
+# (A B, then B A; A B C, B C A, C A B), so that each build runs first as
+# often as the others when the rounds are a multiple of the builds: a build
+# that ran first in every round came out faster than the same code run
+# second (docs/decisions/0053-builds-take-turns-at-running-first.md).
+# Prints one line per
 # build, round and row: `round label row median_us` (the median of
 # REPETITIONS repetitions, default 3, at least 2: Google Benchmark's
 # aggregate), then, per row, each build's median
@@ -21,8 +26,10 @@ filter=$2
 shift 2
 out=$(mktemp)
 trap 'rm -f "$out"' EXIT
+builds=("$@")
 for r in $(seq 1 "$rounds"); do
-  for build in "$@"; do
+  for k in $(seq 0 $(($# - 1))); do
+    build=${builds[$(((r - 1 + k) % $#))]}
     label=${build%%=*}
     bench=${build#*=}
     "$bench" --benchmark_filter="$filter" --benchmark_repetitions="${REPETITIONS:-3}" \
