@@ -20,9 +20,7 @@
 // one loop moved the others' code and with it their speed
 // (docs/decisions/0036-the-avx512-gather-instruction-measured.md). Now the
 // loops of one model, precision and accuracy mode are an object of their own
-// (kernel/units.hpp: kernel/rigid_float_fast.cpp, ...), as are the accumulated
-// passes of one model and precision (kernel/rigid_float_accumulated.cpp, ...),
-// a short compile each,
+// (kernel/units.hpp: kernel/rigid_float_fast.cpp, ...), a short compile each,
 // and every function and loop of a kernel object starts on a 64-byte
 // boundary (cmake/flags.cmake), so a loop's placement does not depend on
 // what precedes it.

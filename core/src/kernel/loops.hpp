@@ -888,8 +888,7 @@ void add_step_loops(GroupLoops<typename V::value_type>& loops) {
 
 /// The slots of one kernel unit in the lanes of this ISA's table: model M's
 /// loops of precision T in mode Mode; the fast mode's unit also holds the loops
-/// that only the fast mode has (the velocity step and the run's), but for the
-/// accumulated passes, a unit of their own (add_accumulated_unit_loops).
+/// that only the fast mode has (the velocity step and the run's).
 template <class M, class T, class Mode>
 void add_unit_loops(KernelTable& table) {
   KernelLoops<T>& loops = *of_precision<T>(&table.loops_float, &table.loops_double);
@@ -897,6 +896,7 @@ void add_unit_loops(KernelTable& table) {
   if constexpr (std::is_same_v<Mode, FastMode>) {
     constexpr std::size_t m = kModelSlot<M>;
     add_step_loops<M, SimdLanes<T>>(loops.groups);
+    add_accumulate_loops<M, SimdLanes<T>>(loops.groups);
     loops.run[m][0] = &run_loop<M, T, false>;
     loops.run[m][1] = &run_loop<M, T, true>;
     loops.geometry[m][0] = &geometry_loop<M, T, false>;
@@ -904,17 +904,6 @@ void add_unit_loops(KernelTable& table) {
     loops.walk[m][0] = &walk_loop<M, T, false>;
     loops.walk[m][1] = &walk_loop<M, T, true>;
   }
-}
-
-/// The slots of the accumulated-passes unit of model M and precision T in the
-/// lanes of this ISA's table (fast mode only). Apart from the fast mode's other
-/// loops because, in one unit with them, they made it the longest compile of
-/// the kernel, longer than the two apart
-/// (docs/decisions/0052-the-accumulated-passes-in-units-of-their-own.md).
-template <class M, class T>
-void add_accumulated_unit_loops(KernelTable& table) {
-  KernelLoops<T>& loops = *of_precision<T>(&table.loops_float, &table.loops_double);
-  add_accumulate_loops<M, SimdLanes<T>>(loops.groups);
 }
 
 /// Model M's one-lane slots of `loops`: both modes, both layouts.

@@ -28,22 +28,16 @@ KernelTable make_table() {
   table.lanes_double = SimdLanes<double>::size();
   add_particle_float_fast(table);
   add_particle_float_accurate(table);
-  add_particle_float_accumulated(table);
   add_particle_double_fast(table);
   add_particle_double_accurate(table);
-  add_particle_double_accumulated(table);
   add_sphere_float_fast(table);
   add_sphere_float_accurate(table);
-  add_sphere_float_accumulated(table);
   add_sphere_double_fast(table);
   add_sphere_double_accurate(table);
-  add_sphere_double_accumulated(table);
   add_rigid_float_fast(table);
   add_rigid_float_accurate(table);
-  add_rigid_float_accumulated(table);
   add_rigid_double_fast(table);
   add_rigid_double_accurate(table);
-  add_rigid_double_accumulated(table);
   return table;
 }
 
