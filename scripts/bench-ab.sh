@@ -6,11 +6,10 @@
 # often as the others when the rounds are a multiple of the builds: a build
 # that ran first in every round came out faster than the same code run
 # second (docs/decisions/0053-builds-take-turns-at-running-first.md).
-# Prints one line per
-# build, round and row: `round label row median_us` (the median of
-# REPETITIONS repetitions, default 3, at least 2: Google Benchmark's
-# aggregate), then, per row, each build's median
-# over the rounds and its ratio to the first build's.
+# Prints one line per build, round and row: `round label row median_us`
+# (the median of REPETITIONS repetitions, default 3, at least 2: Google
+# Benchmark's aggregate), then, per row, each build's median over the
+# rounds and its ratio to the first build's.
 #
 #   scripts/bench-ab.sh ROUNDS FILTER LABEL=BENCH [LABEL=BENCH]...
 #

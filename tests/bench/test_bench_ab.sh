@@ -8,7 +8,7 @@ set -euo pipefail
 root=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-make_bench() {  # name, seconds by round (a file per call counts the rounds)
+make_bench() {  # name, hundreds of its microseconds (plus its call's number, 1 up)
   cat >"$work/$1" <<SH
 #!/bin/sh
 echo $1 >>"$work/ran"
