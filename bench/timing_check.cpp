@@ -29,12 +29,21 @@
 // * A scene passes when every figure is within `tolerance` of the median
 //   of the scene's figures. Timings move with the machine's load: the check
 //   prints the load average, and is worth running only on an idle machine.
+// * What the host's other guests do shows in no load average: the memory
+//   bandwidth of a shared host moves by tens of percent within minutes. So
+//   every round starts with a reading of the 2-thread triad (the arrays of
+//   collide_bench's triad rows, allocated once), one more follows the last
+//   round, and the scene's line gives their range. Where it is wider than
+//   the tolerance the verdict says so: the instruments met different
+//   machines, and a failure then says more of the host than of collide. The
+//   verdict itself is the figures'.
 #include "timing_check.hpp"
 
 #include <benchmark/benchmark.h>
 #include <stdlib.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -44,6 +53,7 @@
 #include <system_error>
 #include <vector>
 
+#include "collide/eval/bandwidth.hpp"
 #include "collide/eval/timing.hpp"
 #include "collide/io/generate.hpp"
 #include "collide/isa.hpp"
@@ -157,6 +167,26 @@ Figure solve_figure(const std::string& collide, const std::filesystem::path& dir
                 "kernel_seconds, median of " + std::to_string(seconds.size()) + " processes"};
 }
 
+/// The host's memory bandwidth now [bytes/s]: the best of three passes of
+/// the 2-thread triad over collide_bench's triad arrays.
+class HostBandwidth {
+ public:
+  HostBandwidth() : arrays_(kThreads) {}
+  double measure() {
+    double best = 0;
+    for (int p = 0; p < 3; ++p) {
+      const auto t0 = std::chrono::steady_clock::now();
+      arrays_.pass();
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (s > 0) best = std::max(best, arrays_.bytes_per_pass() / s);
+    }
+    return best;
+  }
+
+ private:
+  collide::TriadArrays arrays_;
+};
+
 /// One instrument: its name, and how it measures one figure.
 struct Instrument {
   std::string name;
@@ -165,7 +195,8 @@ struct Instrument {
 
 /// Runs the check of one scene; true when it passed.
 bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOptions& options,
-                 const std::string& collide, const std::filesystem::path& root, std::ostream& out) {
+                 const std::string& collide, const std::filesystem::path& root, HostBandwidth& host,
+                 std::ostream& out) {
   const collide::Isa isa = collide::default_isa();
   const bool pile = kind == "pile";
   const std::size_t side = pile ? collide::pile_side_for_contacts(asked) : 0;
@@ -215,7 +246,9 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
   // instrument's figure is the median of its rounds.
   std::vector<std::vector<double>> rounds(instruments.size());
   std::vector<Figure> figures(instruments.size());
+  std::vector<double> host_bytes_per_second;
   for (int r = 0; r < options.rounds; ++r) {
+    host_bytes_per_second.push_back(host.measure());
     for (std::size_t i = 0; i < instruments.size(); ++i) {
       const Figure f = instruments[i].measure();
       if (f.seconds > 0) rounds[i].push_back(f.seconds);
@@ -228,6 +261,7 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
                              : 0;  // a round without a figure fails the scene
     figures[i].detail += "; median of " + std::to_string(rounds[i].size()) + " alternated rounds";
   }
+  host_bytes_per_second.push_back(host.measure());
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
 
@@ -245,8 +279,17 @@ bool check_scene(const std::string& kind, std::size_t asked, const TimingCheckOp
                   within ? "ok" : "OFF", f.detail.c_str());
     out << line;
   }
-  char line[160];
-  std::snprintf(line, sizeof line, "  median %.3f ms: %s\n", 1e3 * median, ok ? "PASS" : "FAIL");
+  const auto [low, high] = std::minmax_element(host_bytes_per_second.begin(), host_bytes_per_second.end());
+  const double host_spread = *low > 0 ? *high / *low : 0;
+  char line[400];
+  std::snprintf(line, sizeof line, "  host: 2-thread triad %.1f to %.1f GB/s over the rounds (%.2fx)\n", *low / 1e9,
+                *high / 1e9, host_spread);
+  out << line;
+  const bool host_moved = !(host_spread > 0 && host_spread - 1 <= options.tolerance);
+  std::snprintf(line, sizeof line, "  median %.3f ms: %s%s\n", 1e3 * median, ok ? "PASS" : "FAIL",
+                host_moved ? " (the host's bandwidth moved more than the tolerance during the rounds: the instruments"
+                             " met different machines)"
+                           : "");
   out << line;
   out.flush();
   return ok;
@@ -279,8 +322,9 @@ int run_timing_check(const TimingCheckOptions& options, std::ostream& out) {
                 load_average() > 0.5 ? " (other processes are running: expect noise)" : "");
   out << line;
   std::size_t failed = 0;
+  HostBandwidth host;
   for (const auto& [kind, n] : options.scenes) {
-    if (!check_scene(kind, n, options, collide, root, out)) ++failed;
+    if (!check_scene(kind, n, options, collide, root, host, out)) ++failed;
   }
   if (own_root) {
     std::error_code ec;
