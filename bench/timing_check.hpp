@@ -16,8 +16,9 @@ namespace collide_bench {
 ///   * collide_bench's row isa/<scene>/f32/<isa>/t:2/n:N (solve_row);
 ///   * `collide solve --stats` kernel_seconds on the scene written by
 ///     `collide gen --format npz`, the median of `runs` processes;
-/// prints them, and fails a scene when a figure is further than
-/// `tolerance` from the scene's median. Returns the exit status: 0 when every
+/// prints them with the range of the host's 2-thread triad over the rounds,
+/// and fails a scene when a figure is further than `tolerance` from the
+/// scene's median. Returns the exit status: 0 when every
 /// scene passed, 1 otherwise. Google Benchmark must be initialised.
 int run_timing_check(const TimingCheckOptions& options, std::ostream& out);
 

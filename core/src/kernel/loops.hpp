@@ -737,8 +737,12 @@ void solve_run_pieces(const View& bodies, const ContactView<T>& contacts, const 
 
 /// A loop: never inlined, and everything it calls inlined into it (flatten),
 /// but for the calls kept out of line on purpose (noinline:
-/// load_streams_out_of_line, evaluate_law_accurately_out_of_line). So a
-/// loop's code depends on its own source alone. Left to GCC's heuristics,
+/// load_streams_out_of_line, evaluate_law_accurately_out_of_line). So what
+/// a loop inlines depends on its own source alone; its register allocation
+/// and stack slots do not: they move when its unit gains or loses other
+/// loops, even with the calls out of line kept from the interprocedural
+/// passes (docs/decisions/0052-the-accumulated-passes-in-units-of-their-own.md),
+/// which is why a unit's loops stay together. Left to GCC's heuristics,
 /// the inlining of what a loop calls beyond the forced inlining of lanes.hpp
 /// (libstdc++'s fixed-size simd operators, which the float accurate mode and
 /// the rigid float fast mode's double lanes use) depends on a budget for the
