@@ -43,7 +43,6 @@
 #include <stdlib.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -172,16 +171,7 @@ Figure solve_figure(const std::string& collide, const std::filesystem::path& dir
 class HostBandwidth {
  public:
   HostBandwidth() : arrays_(kThreads) {}
-  double measure() {
-    double best = 0;
-    for (int p = 0; p < 3; ++p) {
-      const auto t0 = std::chrono::steady_clock::now();
-      arrays_.pass();
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (s > 0) best = std::max(best, arrays_.bytes_per_pass() / s);
-    }
-    return best;
-  }
+  double measure() { return collide::measure_triad(arrays_, 3).bytes_per_second; }
 
  private:
   collide::TriadArrays arrays_;

@@ -244,8 +244,12 @@ std::size_t TriadArrays::elements() const { return impl_->n; }
 int TriadArrays::threads() const { return impl_->threads; }
 
 TriadResult measure_triad(int threads, std::size_t array_bytes, int passes) {
-  passes = std::max(1, passes);
   TriadArrays triad(threads, array_bytes);
+  return measure_triad(triad, passes);
+}
+
+TriadResult measure_triad(TriadArrays& triad, int passes) {
+  passes = std::max(1, passes);
   std::vector<double> seconds;
   for (int p = 0; p < passes; ++p) {
     const auto t0 = std::chrono::steady_clock::now();

@@ -7,7 +7,8 @@
 //   element and pass, and clamps a thread count below 1 to 1.
 // * measure_triad reports what it measured: the best pass is at least the
 //   median, both are positive and finite, and it echoes the array size, the
-//   threads and the passes it used. (Speeds are not asserted: they belong to
+//   threads and the passes it used; so does its overload over the caller's
+//   arrays, which takes fewer than one pass as one. (Speeds are not asserted: they belong to
 //   the benchmarks.)
 // * Cache sizes: /sys first (a fake cache directory in the build tree), else
 //   sysconf, else CPUID (both faked through MachineProbe); a size no source
@@ -52,6 +53,19 @@ TEST(Bandwidth, MeasureTriadReportsWhatItMeasured) {
     EXPECT_EQ(r.array_bytes, std::size_t{4} << 20);
     EXPECT_EQ(r.threads, threads);
     EXPECT_EQ(r.passes, 5);
+  }
+}
+
+TEST(Bandwidth, MeasureTriadOverTheCallersArrays) {
+  TriadArrays triad(2, std::size_t{4} << 20);
+  for (const int passes : {0, 3}) {  // fewer than one pass is taken as one
+    const TriadResult r = measure_triad(triad, passes);
+    EXPECT_TRUE(std::isfinite(r.bytes_per_second));
+    EXPECT_GT(r.median_bytes_per_second, 0);
+    EXPECT_GE(r.bytes_per_second, r.median_bytes_per_second);
+    EXPECT_EQ(r.array_bytes, std::size_t{4} << 20);
+    EXPECT_EQ(r.threads, 2);
+    EXPECT_EQ(r.passes, passes < 1 ? 1 : passes);
   }
 }
 

@@ -125,4 +125,9 @@ class TriadArrays {
 /// for the duration of the call.
 TriadResult measure_triad(int threads, std::size_t array_bytes = 0, int passes = 10);
 
+/// The same over the caller's arrays, allocating nothing: `passes` timed
+/// passes (at least 1) of `triad`, for a caller that reads the bandwidth
+/// again and again (collide_bench --timing-check, once a round).
+TriadResult measure_triad(TriadArrays& triad, int passes = 10);
+
 }  // namespace collide
