@@ -8,8 +8,8 @@
 // * measure_triad reports what it measured: the best pass is at least the
 //   median, both are positive and finite, and it echoes the array size, the
 //   threads and the passes it used; so does its overload over the caller's
-//   arrays, which takes fewer than one pass as one. (Speeds are not asserted: they belong to
-//   the benchmarks.)
+//   arrays, which takes fewer than one pass as one. (Speeds are not
+//   asserted: they belong to the benchmarks.)
 // * Cache sizes: /sys first (a fake cache directory in the build tree), else
 //   sysconf, else CPUID (both faked through MachineProbe); a size no source
 //   gives is unknown, never 0; the data cache, not the instruction cache.
